@@ -23,10 +23,7 @@ pub const SLAB_FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
 
 impl Aabb {
     /// The empty box.
-    pub const EMPTY: Self = Self {
-        min: Vec3::INFINITY,
-        max: Vec3::NEG_INFINITY,
-    };
+    pub const EMPTY: Self = Self { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
 
     /// A box from its corners (not reordered).
     #[inline]
@@ -45,20 +42,14 @@ impl Aabb {
     #[inline]
     #[must_use]
     pub fn grow(self, p: Vec3) -> Self {
-        Self {
-            min: min3(self.min, p),
-            max: max3(self.max, p),
-        }
+        Self { min: min3(self.min, p), max: max3(self.max, p) }
     }
 
     /// The smallest box holding both.
     #[inline]
     #[must_use]
     pub fn union(self, other: Self) -> Self {
-        Self {
-            min: min3(self.min, other.min),
-            max: max3(self.max, other.max),
-        }
+        Self { min: min3(self.min, other.min), max: max3(self.max, other.max) }
     }
 
     /// Whether the box holds no point (`min > max` on some axis, or NaN).

@@ -108,11 +108,7 @@ impl Camera {
         let ok = match projection {
             Projection::Perspective { fov_y } => in_fov(fov_y),
             Projection::Orthographic { height } => height.is_finite() && height > 0.0,
-            Projection::ThinLens {
-                fov_y,
-                aperture_radius,
-                focus_distance,
-            } => {
+            Projection::ThinLens { fov_y, aperture_radius, focus_distance } => {
                 in_fov(fov_y)
                     && aperture_radius.is_finite()
                     && aperture_radius >= 0.0
@@ -132,15 +128,7 @@ impl Camera {
             return Err(CameraError::UpParallelToView);
         }
         let up = right.cross(forward);
-        Ok(Self {
-            eye,
-            forward,
-            right,
-            up,
-            projection,
-            width,
-            height,
-        })
+        Ok(Self { eye, forward, right, up, projection, width, height })
     }
 
     /// Width over height.
@@ -165,11 +153,7 @@ impl Camera {
                 let o = self.eye + (sx * h * self.aspect()) * self.right + (sy * h) * self.up;
                 Ray::new(o, self.forward)
             }
-            Projection::ThinLens {
-                fov_y,
-                aperture_radius,
-                focus_distance,
-            } => {
+            Projection::ThinLens { fov_y, aperture_radius, focus_distance } => {
                 let d = self.pinhole_dir(fov_y, sx, sy);
                 // `d` has unit component along `forward`, so the focal plane
                 // is reached at parameter `focus_distance`.
@@ -198,10 +182,7 @@ pub fn concentric_disk(u: Vec2) -> Vec2 {
     let (r, theta) = if o.x.abs() > o.y.abs() {
         (o.x, core::f32::consts::FRAC_PI_4 * (o.y / o.x))
     } else {
-        (
-            o.y,
-            core::f32::consts::FRAC_PI_2 - core::f32::consts::FRAC_PI_4 * (o.x / o.y),
-        )
+        (o.y, core::f32::consts::FRAC_PI_2 - core::f32::consts::FRAC_PI_4 * (o.x / o.y))
     };
     let (s, c) = sin_cos(theta);
     r * Vec2::new(c, s)
@@ -225,9 +206,7 @@ mod tests {
 
     #[test]
     fn centre_ray_looks_at_target_and_corners_span_fov() {
-        let c = cam(Projection::Perspective {
-            fov_y: core::f32::consts::FRAC_PI_2,
-        });
+        let c = cam(Projection::Perspective { fov_y: core::f32::consts::FRAC_PI_2 });
         let r = c.generate_ray(100, 50, Vec2::ZERO, Vec2::ZERO);
         assert!((r.direction - Vec3::NEG_Z).length() < 1e-6);
         // Top edge of the image: 45° up.
@@ -249,20 +228,11 @@ mod tests {
 
     #[test]
     fn thin_lens_rays_converge_on_focal_plane() {
-        let p = Projection::ThinLens {
-            fov_y: 1.0,
-            aperture_radius: 0.5,
-            focus_distance: 5.0,
-        };
+        let p = Projection::ThinLens { fov_y: 1.0, aperture_radius: 0.5, focus_distance: 5.0 };
         let c = cam(p);
         let mut pts = [Vec3::ZERO; 3];
-        for (i, l) in [
-            Vec2::new(0.1, 0.2),
-            Vec2::new(0.9, 0.5),
-            Vec2::new(0.4, 0.95),
-        ]
-        .iter()
-        .enumerate()
+        for (i, l) in
+            [Vec2::new(0.1, 0.2), Vec2::new(0.9, 0.5), Vec2::new(0.4, 0.95)].iter().enumerate()
         {
             let r = c.generate_ray(30, 70, Vec2::splat(0.5), *l);
             let t = (0.0 - r.origin.z) / r.direction.z;

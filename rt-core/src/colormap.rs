@@ -22,10 +22,7 @@ impl ColorStop {
     /// An opaque stop.
     #[must_use]
     pub const fn rgb(pos: f32, r: f32, g: f32, b: f32) -> Self {
-        Self {
-            pos,
-            rgba: [r, g, b, 1.0],
-        }
+        Self { pos, rgba: [r, g, b, 1.0] }
     }
 }
 
@@ -93,12 +90,7 @@ impl<'a> ColorMap<'a> {
             }
             prev = s.pos;
         }
-        let mut map = Self {
-            stops,
-            lo: 0.0,
-            hi: 1.0,
-            nan_color: [1.0, 1.0, 0.0, 1.0],
-        };
+        let mut map = Self { stops, lo: 0.0, hi: 1.0, nan_color: [1.0, 1.0, 0.0, 1.0] };
         map.set_range(lo, hi)?;
         Ok(map)
     }
@@ -125,36 +117,21 @@ impl<'a> ColorMap<'a> {
     /// Black → white.
     #[must_use]
     pub fn grayscale() -> ColorMap<'static> {
-        ColorMap {
-            stops: &GRAYSCALE,
-            lo: 0.0,
-            hi: 1.0,
-            nan_color: [1.0, 0.0, 0.0, 1.0],
-        }
+        ColorMap { stops: &GRAYSCALE, lo: 0.0, hi: 1.0, nan_color: [1.0, 0.0, 0.0, 1.0] }
     }
 
     /// Matplotlib's viridis (van der Walt & Smith), perceptually uniform;
     /// 33 stops sampled from its 256-entry table.
     #[must_use]
     pub fn viridis() -> ColorMap<'static> {
-        ColorMap {
-            stops: &VIRIDIS,
-            lo: 0.0,
-            hi: 1.0,
-            nan_color: [1.0, 0.0, 0.0, 1.0],
-        }
+        ColorMap { stops: &VIRIDIS, lo: 0.0, hi: 1.0, nan_color: [1.0, 0.0, 0.0, 1.0] }
     }
 
     /// Moreland's cool-to-warm diverging map (ParaView's default), his
     /// 33-entry table ("Diverging Color Maps for Scientific Visualization", 2009).
     #[must_use]
     pub fn cool_to_warm() -> ColorMap<'static> {
-        ColorMap {
-            stops: &COOL_TO_WARM,
-            lo: 0.0,
-            hi: 1.0,
-            nan_color: [1.0, 1.0, 0.0, 1.0],
-        }
+        ColorMap { stops: &COOL_TO_WARM, lo: 0.0, hi: 1.0, nan_color: [1.0, 1.0, 0.0, 1.0] }
     }
 
     /// The same map over another range (see [`ColorMap::set_range`]).
@@ -174,11 +151,7 @@ impl<'a> ColorMap<'a> {
             return self.nan_color;
         }
         let span = self.hi - self.lo;
-        let x = if span > 0.0 {
-            ((s - self.lo) / span).clamp(0.0, 1.0)
-        } else {
-            0.5
-        };
+        let x = if span > 0.0 { ((s - self.lo) / span).clamp(0.0, 1.0) } else { 0.5 };
         // First stop at or beyond x (stops are sorted).
         let i = self.stops.partition_point(|st| st.pos < x);
         if i == 0 {
@@ -188,11 +161,7 @@ impl<'a> ColorMap<'a> {
             return self.stops[i - 1].rgba;
         }
         let (a, b) = (&self.stops[i - 1], &self.stops[i]);
-        let w = if b.pos > a.pos {
-            (x - a.pos) / (b.pos - a.pos)
-        } else {
-            1.0
-        };
+        let w = if b.pos > a.pos { (x - a.pos) / (b.pos - a.pos) } else { 1.0 };
         core::array::from_fn(|k| a.rgba[k] + w * (b.rgba[k] - a.rgba[k]))
     }
 
@@ -203,10 +172,8 @@ impl<'a> ColorMap<'a> {
     }
 }
 
-static GRAYSCALE: [ColorStop; 2] = [
-    ColorStop::rgb(0.0, 0.0, 0.0, 0.0),
-    ColorStop::rgb(1.0, 1.0, 1.0, 1.0),
-];
+static GRAYSCALE: [ColorStop; 2] =
+    [ColorStop::rgb(0.0, 0.0, 0.0, 0.0), ColorStop::rgb(1.0, 1.0, 1.0, 1.0)];
 
 static VIRIDIS: [ColorStop; 33] = [
     ColorStop::rgb(0.000000, 0.267004, 0.004874, 0.329415),
@@ -309,16 +276,10 @@ mod tests {
 
     #[test]
     fn user_stops_are_validated() {
-        let ok = [
-            ColorStop::rgb(0.0, 1.0, 0.0, 0.0),
-            ColorStop::rgb(1.0, 0.0, 0.0, 1.0),
-        ];
+        let ok = [ColorStop::rgb(0.0, 1.0, 0.0, 0.0), ColorStop::rgb(1.0, 0.0, 0.0, 1.0)];
         let m = ColorMap::from_stops(&ok, -1.0, 1.0).unwrap();
         assert_eq!(m.map(0.0), [0.5, 0.0, 0.5, 1.0]);
-        assert_eq!(
-            ColorMap::from_stops(&ok[..1], 0.0, 1.0),
-            Err(ColorMapError::TooFewStops)
-        );
+        assert_eq!(ColorMap::from_stops(&ok[..1], 0.0, 1.0), Err(ColorMapError::TooFewStops));
         let bad = [ok[1], ok[0]];
         assert_eq!(
             ColorMap::from_stops(&bad, 0.0, 1.0),
@@ -329,9 +290,6 @@ mod tests {
             ColorMap::from_stops(&nan, 0.0, 1.0),
             Err(ColorMapError::NonFinite { index: 1 })
         );
-        assert_eq!(
-            ColorMap::from_stops(&ok, 1.0, 0.0),
-            Err(ColorMapError::BadRange)
-        );
+        assert_eq!(ColorMap::from_stops(&ok, 1.0, 0.0), Err(ColorMapError::BadRange));
     }
 }

@@ -18,10 +18,7 @@ pub struct Pixel {
 
 impl Pixel {
     /// Transparent black at infinite depth: the identity of compositing.
-    pub const BACKGROUND: Self = Self {
-        color: [0.0; 4],
-        depth: f32::INFINITY,
-    };
+    pub const BACKGROUND: Self = Self { color: [0.0; 4], depth: f32::INFINITY };
 }
 
 /// Why a frame could not be made.
@@ -73,15 +70,9 @@ impl Frame {
         }
         let n = usize::try_from(n).map_err(|_| FrameError::TooLarge)?;
         let mut pixels = Vec::new();
-        pixels
-            .try_reserve_exact(n)
-            .map_err(|_| FrameError::OutOfMemory)?;
+        pixels.try_reserve_exact(n).map_err(|_| FrameError::OutOfMemory)?;
         pixels.resize(n, Pixel::BACKGROUND);
-        Ok(Self {
-            width,
-            height,
-            pixels,
-        })
+        Ok(Self { width, height, pixels })
     }
 
     /// Width in pixels.
@@ -148,11 +139,7 @@ impl Frame {
 #[must_use]
 pub fn linear_to_srgb(x: f32) -> f32 {
     let x = if x > 0.0 { x.min(1.0) } else { 0.0 };
-    if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * powf(x, 1.0 / 2.4) - 0.055
-    }
+    if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * powf(x, 1.0 / 2.4) - 0.055 }
 }
 
 fn to_u8(x: f32) -> u8 {
@@ -178,10 +165,7 @@ mod tests {
     #[test]
     fn srgb_export_unpremultiplies() {
         let mut f = Frame::new(1, 1).unwrap();
-        *f.get_mut(0, 0).unwrap() = Pixel {
-            color: [0.5, 0.0, 0.25, 0.5],
-            depth: 1.0,
-        };
+        *f.get_mut(0, 0).unwrap() = Pixel { color: [0.5, 0.0, 0.25, 0.5], depth: 1.0 };
         assert_eq!(f.to_srgba8(), alloc::vec![255, 0, 188, 128]);
         assert_eq!(linear_to_srgb(f32::NAN), 0.0);
     }

@@ -24,24 +24,14 @@ impl Ray {
     #[inline]
     #[must_use]
     pub const fn new(origin: Vec3, direction: Vec3) -> Self {
-        Self {
-            origin,
-            direction,
-            t_min: 0.0,
-            t_max: f32::INFINITY,
-        }
+        Self { origin, direction, t_min: 0.0, t_max: f32::INFINITY }
     }
 
     /// A ray over `[t_min, t_max]`.
     #[inline]
     #[must_use]
     pub const fn with_range(origin: Vec3, direction: Vec3, t_min: f32, t_max: f32) -> Self {
-        Self {
-            origin,
-            direction,
-            t_min,
-            t_max,
-        }
+        Self { origin, direction, t_min, t_max }
     }
 
     /// The point at parameter `t`.

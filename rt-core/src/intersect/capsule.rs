@@ -36,12 +36,7 @@ impl Capsule {
     #[inline]
     #[must_use]
     pub const fn new(p0: Vec3, p1: Vec3, radius: f32) -> Self {
-        Self {
-            p0,
-            radius,
-            p1,
-            pad: 0.0,
-        }
+        Self { p0, radius, p1, pad: 0.0 }
     }
 
     /// Whether the end points are finite and the radius finite and positive.
@@ -57,11 +52,7 @@ impl Capsule {
     pub fn axial(&self, p: Vec3) -> f32 {
         let ba = self.p1 - self.p0;
         let l2 = ba.length_squared();
-        if l2 > 0.0 {
-            ((p - self.p0).dot(ba) / l2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        }
+        if l2 > 0.0 { ((p - self.p0).dot(ba) / l2).clamp(0.0, 1.0) } else { 0.0 }
     }
 }
 

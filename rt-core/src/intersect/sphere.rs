@@ -46,7 +46,7 @@ impl Sphere {
 #[inline]
 #[must_use]
 pub fn solve_quadratic(a: f32, b: f32, c: f32, disc_over_a: f32) -> Option<(f32, f32)> {
-    if !(disc_over_a >= 0.0) || a == 0.0 {
+    if disc_over_a.is_nan() || disc_over_a < 0.0 || a == 0.0 {
         return None;
     }
     let root = sqrt(a * disc_over_a);

@@ -43,10 +43,7 @@ impl WatertightRay {
             core::mem::swap(&mut kx, &mut ky);
         }
         let sz = 1.0 / d[kz];
-        Self {
-            axes: [kx, ky, kz],
-            shear: Vec3::new(d[kx] * sz, d[ky] * sz, sz),
-        }
+        Self { axes: [kx, ky, kz], shear: Vec3::new(d[kx] * sz, d[ky] * sz, sz) }
     }
 }
 
@@ -107,11 +104,7 @@ pub fn intersect_triangle_t(
     if !(t >= ray.t_min && t <= ray.t_max) {
         return None;
     }
-    Some(TriangleHit {
-        t,
-        b1: v * inv,
-        b2: w * inv,
-    })
+    Some(TriangleHit { t, b1: v * inv, b2: w * inv })
 }
 
 /// Whether the triangle has zero area: its edge cross product, evaluated in

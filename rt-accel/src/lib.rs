@@ -1,0 +1,82 @@
+//! # rt-accel
+//!
+//! A 4-wide bounding volume hierarchy for the `rt` crates. Trees are built
+//! with [obvhs](https://crates.io/crates/obvhs)'s PLOC builder (feature
+//! `obvhs`), then converted to a layout of our own: plain `bytemuck::Pod`
+//! nodes holding four child boxes in structure-of-arrays form, tested in
+//! one SSE pass, and leaves of triangle packets tested four at a time with
+//! the watertight algorithm. The layout can be written to bytes, loaded
+//! elsewhere (checked: malformed bytes are an `Err`) and traversed with no
+//! std and no allocation.
+//!
+//! Queries: [`BvhRef::closest_hit`] (ties in `t` go to the lower primitive
+//! index, so the answer does not depend on traversal order) and
+//! [`BvhRef::occluded`] (stops at the first hit). Both implement
+//! [`rt_core::SceneQuery`]. Moving geometry is handled by refitting
+//! ([`Bvh::refit_triangles`]) without a rebuild.
+//!
+//! ## Features
+//! | feature | default | what it does |
+//! |---|---|---|
+//! | `std` | yes | std float functions; implies `alloc` |
+//! | `alloc` | via `std` | owned [`Bvh`], [`Scene`], [`TriangleMesh`], copying loader, refit |
+//! | `obvhs` | yes | building ([`build_triangles`], [`build_spheres`], [`build_capsules`]); needs std |
+//! | `libm` | no | float functions from `libm` for `no_std` |
+//!
+//! ## Example
+//! ```
+//! use rt_accel::{BuildParams, build_triangles};
+//! use rt_core::{Ray, glam::Vec3};
+//!
+//! let positions = [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+//! let bvh = build_triangles(&positions, &[[0, 1, 2]], &BuildParams::medium()).unwrap();
+//! let hit = bvh.closest_hit(&Ray::new(Vec3::new(0.0, 0.0, 3.0), Vec3::NEG_Z)).unwrap();
+//! assert_eq!((hit.t, hit.prim), (3.0, 0));
+//! // Round trip through bytes.
+//! let bytes = bvh.to_bytes();
+//! let loaded = rt_accel::Bvh::<rt_accel::TriPacket>::from_bytes(&bytes).unwrap();
+//! assert_eq!(loaded, bvh);
+//! ```
+#![no_std]
+
+#[cfg(feature = "alloc")]
+extern crate alloc;
+#[cfg(feature = "std")]
+extern crate std;
+
+#[cfg(feature = "obvhs")]
+mod build;
+#[cfg(feature = "alloc")]
+mod bvh;
+mod bytes;
+#[cfg(feature = "alloc")]
+mod check;
+mod error;
+#[cfg(feature = "alloc")]
+mod mesh;
+mod node;
+mod prim;
+mod ray_ctx;
+#[cfg(feature = "alloc")]
+mod refit;
+#[cfg(feature = "alloc")]
+mod scene;
+mod simd;
+mod traverse;
+mod tri_packet;
+
+#[cfg(feature = "obvhs")]
+pub use build::{BuildParams, BuildQuality, build_capsules, build_spheres, build_triangles};
+#[cfg(feature = "alloc")]
+pub use bvh::Bvh;
+pub use bytes::{Header, MAGIC, VERSION, validate};
+pub use error::{BuildError, LoadError};
+#[cfg(feature = "alloc")]
+pub use mesh::TriangleMesh;
+pub use node::{ChildRef, MAX_ITEMS, MAX_LEAF_ITEMS, Node};
+pub use prim::{BestHit, CapsuleItem, Primitive, SphereItem};
+pub use ray_ctx::RayCtx;
+#[cfg(feature = "alloc")]
+pub use scene::Scene;
+pub use traverse::{BvhRef, MAX_DEPTH, STACK_SIZE, TraversalStats};
+pub use tri_packet::TriPacket;

@@ -1,0 +1,172 @@
+//! What a BVH leaf can hold: the [`Primitive`] trait and its sphere and
+//! capsule items (triangles come in packets of four, see
+//! [`crate::TriPacket`]).
+
+use rt_core::{
+    Aabb, Hit, PrimKind, Ray,
+    intersect::{
+        Capsule, Sphere, intersect_capsule, intersect_capsule_t, intersect_sphere,
+        intersect_sphere_t,
+    },
+};
+
+use crate::RayCtx;
+
+/// The closest hit found so far during a traversal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BestHit {
+    /// Ray parameter (initially the ray's `t_max`).
+    pub t: f32,
+    /// Primitive index of the hit (`u32::MAX` before any).
+    pub prim: u32,
+    /// Leaf item holding it.
+    pub item: u32,
+    /// Lane within the item (packets hold several primitives).
+    pub lane: u32,
+}
+
+impl BestHit {
+    /// No hit yet, searching up to `t_max`.
+    #[inline]
+    #[must_use]
+    pub const fn new(t_max: f32) -> Self {
+        Self { t: t_max, prim: u32::MAX, item: u32::MAX, lane: 0 }
+    }
+
+    /// Offers a hit; it wins if closer, or equally close with a lower
+    /// primitive index (so the answer does not depend on visiting order).
+    #[inline]
+    pub fn offer(&mut self, t: f32, prim: u32, item: u32, lane: u32) {
+        if t < self.t || (t == self.t && prim < self.prim) {
+            *self = Self { t, prim, item, lane };
+        }
+    }
+
+    /// Whether any hit was recorded.
+    #[inline]
+    #[must_use]
+    pub fn is_hit(&self) -> bool {
+        self.prim != u32::MAX
+    }
+}
+
+mod sealed {
+    pub trait Sealed {}
+}
+pub(crate) use sealed::Sealed;
+
+/// A leaf item: one or more primitives tested together. Implemented by
+/// [`crate::TriPacket`], [`SphereItem`] and [`CapsuleItem`]; sealed.
+pub trait Primitive: bytemuck::Pod + Sealed {
+    /// The kind reported in hits.
+    const KIND: PrimKind;
+    /// Tag stored in serialized BVHs.
+    const TAG: u32;
+
+    /// Offers every hit of this item with `t ∈ [t_min, best.t]` to `best`.
+    fn closest(&self, item: u32, ray: &RayCtx, best: &mut BestHit);
+    /// Whether any primitive of the item is hit with `t ∈ [t_min, t_max]`.
+    fn any(&self, ray: &RayCtx, t_max: f32) -> bool;
+    /// The full hit record for `lane`, whose hit at parameter `t` was found
+    /// by [`Primitive::closest`].
+    fn hit(&self, lane: u32, ray: &Ray, t: f32) -> Option<Hit>;
+    /// The box around the item's primitives.
+    fn bounds(&self) -> Aabb;
+    /// Whether the item's data are well formed, with primitive ids below
+    /// `prim_count` (checked when loading bytes).
+    fn is_well_formed(&self, prim_count: u32) -> bool;
+}
+
+/// A sphere with its primitive index, as stored in leaves.
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+pub struct SphereItem {
+    /// The sphere.
+    pub sphere: Sphere,
+    /// Index in the input list.
+    pub prim: u32,
+    /// Padding to 32 bytes; always 0.
+    pub pad: [u32; 3],
+}
+
+/// A capsule with its primitive index, as stored in leaves.
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+pub struct CapsuleItem {
+    /// The capsule.
+    pub capsule: Capsule,
+    /// Index in the input list.
+    pub prim: u32,
+    /// Padding to 48 bytes; always 0.
+    pub pad: [u32; 3],
+}
+
+impl Sealed for SphereItem {}
+impl Sealed for CapsuleItem {}
+
+impl Primitive for SphereItem {
+    const KIND: PrimKind = PrimKind::Sphere;
+    const TAG: u32 = 2;
+
+    #[inline]
+    fn closest(&self, item: u32, ray: &RayCtx, best: &mut BestHit) {
+        let r = Ray::with_range(ray.ray.origin, ray.ray.direction, ray.ray.t_min, best.t);
+        if let Some(t) = intersect_sphere_t(&r, &self.sphere) {
+            best.offer(t, self.prim, item, 0);
+        }
+    }
+
+    #[inline]
+    fn any(&self, ray: &RayCtx, t_max: f32) -> bool {
+        let r = Ray::with_range(ray.ray.origin, ray.ray.direction, ray.ray.t_min, t_max);
+        intersect_sphere_t(&r, &self.sphere).is_some()
+    }
+
+    fn hit(&self, _lane: u32, ray: &Ray, t: f32) -> Option<Hit> {
+        let r = Ray::with_range(ray.origin, ray.direction, t, t);
+        intersect_sphere(&r, &self.sphere, self.prim)
+    }
+
+    fn bounds(&self) -> Aabb {
+        let r = glam::Vec3::splat(self.sphere.radius);
+        Aabb::new(self.sphere.center - r, self.sphere.center + r)
+    }
+
+    fn is_well_formed(&self, prim_count: u32) -> bool {
+        self.sphere.is_valid() && self.prim < prim_count
+    }
+}
+
+impl Primitive for CapsuleItem {
+    const KIND: PrimKind = PrimKind::Capsule;
+    const TAG: u32 = 3;
+
+    #[inline]
+    fn closest(&self, item: u32, ray: &RayCtx, best: &mut BestHit) {
+        let r = Ray::with_range(ray.ray.origin, ray.ray.direction, ray.ray.t_min, best.t);
+        if let Some(t) = intersect_capsule_t(&r, &self.capsule) {
+            best.offer(t, self.prim, item, 0);
+        }
+    }
+
+    #[inline]
+    fn any(&self, ray: &RayCtx, t_max: f32) -> bool {
+        let r = Ray::with_range(ray.ray.origin, ray.ray.direction, ray.ray.t_min, t_max);
+        intersect_capsule_t(&r, &self.capsule).is_some()
+    }
+
+    fn hit(&self, _lane: u32, ray: &Ray, t: f32) -> Option<Hit> {
+        let r = Ray::with_range(ray.origin, ray.direction, t, t);
+        intersect_capsule(&r, &self.capsule, self.prim)
+    }
+
+    fn bounds(&self) -> Aabb {
+        let c = &self.capsule;
+        let r = glam::Vec3::splat(c.radius);
+        Aabb::new(c.p0 - r, c.p0 + r).union(Aabb::new(c.p1 - r, c.p1 + r))
+    }
+
+    fn is_well_formed(&self, prim_count: u32) -> bool {
+        self.capsule.is_valid() && self.prim < prim_count
+    }
+}

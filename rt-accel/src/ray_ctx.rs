@@ -1,0 +1,76 @@
+//! Per-ray constants shared by the box tests and the leaf tests.
+
+use rt_core::{Ray, SLAB_FAR_SCALE, intersect::WatertightRay};
+
+use crate::simd::F32x4;
+
+/// Everything a traversal precomputes once per ray: splatted origin and
+/// reciprocal direction, the near/far plane selection by direction sign, and
+/// the watertight triangle shear.
+#[derive(Clone, Copy, Debug)]
+pub struct RayCtx {
+    pub(crate) ray: Ray,
+    /// Origin per axis, splatted.
+    pub(crate) org: [F32x4; 3],
+    /// Reciprocal direction per axis (`±∞` for `±0`), splatted.
+    pub(crate) inv: [F32x4; 3],
+    /// Row of `Node::bounds` holding the near plane per axis (by sign bit).
+    pub(crate) near: [usize; 3],
+    /// Row holding the far plane per axis.
+    pub(crate) far: [usize; 3],
+    pub(crate) far_scale: F32x4,
+    pub(crate) t_min: F32x4,
+    /// Watertight shear constants for triangles.
+    pub(crate) wt: WatertightRay,
+    /// Origin permuted to `[kx, ky, kz]`, splatted.
+    pub(crate) wt_org: [F32x4; 3],
+    /// `(Sx, Sy, Sz)` splatted.
+    pub(crate) wt_shear: [F32x4; 3],
+}
+
+impl RayCtx {
+    /// The constants for `ray`, or `None` if the ray is not valid
+    /// ([`Ray::is_valid`]): such rays miss everything.
+    #[inline]
+    #[must_use]
+    pub fn new(ray: &Ray) -> Option<Self> {
+        if !ray.is_valid() {
+            return None;
+        }
+        let o = ray.origin;
+        let d = ray.direction;
+        let inv = d.recip();
+        let sel = |a: usize| {
+            let neg = usize::from(d[a].is_sign_negative());
+            (2 * a + neg, 2 * a + 1 - neg)
+        };
+        let (nx, fx) = sel(0);
+        let (ny, fy) = sel(1);
+        let (nz, fz) = sel(2);
+        let wt = WatertightRay::new(ray);
+        let [kx, ky, kz] = wt.axes;
+        Some(Self {
+            ray: *ray,
+            org: [F32x4::splat(o.x), F32x4::splat(o.y), F32x4::splat(o.z)],
+            inv: [F32x4::splat(inv.x), F32x4::splat(inv.y), F32x4::splat(inv.z)],
+            near: [nx, ny, nz],
+            far: [fx, fy, fz],
+            far_scale: F32x4::splat(SLAB_FAR_SCALE),
+            t_min: F32x4::splat(ray.t_min),
+            wt,
+            wt_org: [F32x4::splat(o[kx]), F32x4::splat(o[ky]), F32x4::splat(o[kz])],
+            wt_shear: [
+                F32x4::splat(wt.shear.x),
+                F32x4::splat(wt.shear.y),
+                F32x4::splat(wt.shear.z),
+            ],
+        })
+    }
+
+    /// The ray these constants were made for.
+    #[inline]
+    #[must_use]
+    pub fn ray(&self) -> &Ray {
+        &self.ray
+    }
+}

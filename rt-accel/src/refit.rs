@@ -1,0 +1,84 @@
+//! Refitting after primitives move: same tree, new boxes.
+
+use glam::Vec3;
+use rt_core::intersect::{Capsule, Sphere};
+
+use crate::{BuildError, Bvh, CapsuleItem, SphereItem, TriPacket, check::triangle_vertices};
+
+impl Bvh<TriPacket> {
+    /// Moves every triangle to its new vertices (`indices` must be the list
+    /// the BVH was built from, `positions` the moved vertices) and refits
+    /// the boxes. Triangles left out at build time as degenerate stay out
+    /// until a rebuild.
+    ///
+    /// # Errors
+    /// [`BuildError::RefitMismatch`] if `indices` has a different length,
+    /// else as [`crate::build_triangles`]; on error nothing is changed.
+    pub fn refit_triangles(
+        &mut self,
+        positions: &[Vec3],
+        indices: &[[u32; 3]],
+    ) -> Result<(), BuildError> {
+        if indices.len() != self.prim_count as usize {
+            return Err(BuildError::RefitMismatch);
+        }
+        // Check everything before writing anything.
+        for v in triangle_vertices(positions, indices)? {
+            v?;
+        }
+        self.refit_with(|items| {
+            for packet in items {
+                for lane in 0..packet.len() {
+                    let idx = indices[packet.prims[lane] as usize];
+                    let verts = idx.map(|i| positions[i as usize]);
+                    packet.set_lane(lane, packet.prims[lane], verts);
+                }
+            }
+            Ok(())
+        })
+    }
+}
+
+impl Bvh<SphereItem> {
+    /// Moves (and resizes) every sphere and refits the boxes.
+    ///
+    /// # Errors
+    /// [`BuildError::RefitMismatch`] for a different count,
+    /// [`BuildError::InvalidPrimitive`] for a bad sphere; nothing changes.
+    pub fn refit_spheres(&mut self, spheres: &[Sphere]) -> Result<(), BuildError> {
+        if spheres.len() != self.prim_count as usize {
+            return Err(BuildError::RefitMismatch);
+        }
+        if let Some(index) = spheres.iter().position(|s| !s.is_valid()) {
+            return Err(BuildError::InvalidPrimitive { index });
+        }
+        self.refit_with(|items| {
+            for it in items {
+                it.sphere = spheres[it.prim as usize];
+            }
+            Ok(())
+        })
+    }
+}
+
+impl Bvh<CapsuleItem> {
+    /// Moves every capsule and refits the boxes.
+    ///
+    /// # Errors
+    /// [`BuildError::RefitMismatch`] for a different count,
+    /// [`BuildError::InvalidPrimitive`] for a bad capsule; nothing changes.
+    pub fn refit_capsules(&mut self, capsules: &[Capsule]) -> Result<(), BuildError> {
+        if capsules.len() != self.prim_count as usize {
+            return Err(BuildError::RefitMismatch);
+        }
+        if let Some(index) = capsules.iter().position(|c| !c.is_valid()) {
+            return Err(BuildError::InvalidPrimitive { index });
+        }
+        self.refit_with(|items| {
+            for it in items {
+                it.capsule = capsules[it.prim as usize];
+            }
+            Ok(())
+        })
+    }
+}

@@ -1,0 +1,41 @@
+//! A scene of triangles, spheres and capsules behind one query.
+
+use rt_core::{Hit, Ray, SceneQuery};
+
+use crate::{Bvh, CapsuleItem, SphereItem, TriPacket};
+
+/// One BVH per primitive kind; kinds a scene lacks cost nothing. Hits from
+/// different kinds are told apart by [`Hit::kind`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Triangle meshes.
+    pub triangles: Bvh<TriPacket>,
+    /// Spheres.
+    pub spheres: Bvh<SphereItem>,
+    /// Capsules.
+    pub capsules: Bvh<CapsuleItem>,
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Self { triangles: Bvh::empty(), spheres: Bvh::empty(), capsules: Bvh::empty() }
+    }
+}
+
+impl SceneQuery for Scene {
+    fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        // Each later kind searches only up to the best hit so far; on equal
+        // `t` the earlier kind wins.
+        let closer = |best: Option<Hit>, next: &dyn Fn(&Ray) -> Option<Hit>| {
+            let r = Ray { t_max: best.map_or(ray.t_max, |h| h.t), ..*ray };
+            next(&r).filter(|h| best.is_none_or(|b| h.t < b.t)).or(best)
+        };
+        let best = self.triangles.closest_hit(ray);
+        let best = closer(best, &|r| self.spheres.closest_hit(r));
+        closer(best, &|r| self.capsules.closest_hit(r))
+    }
+
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.triangles.occluded(ray) || self.spheres.occluded(ray) || self.capsules.occluded(ray)
+    }
+}

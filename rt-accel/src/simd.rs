@@ -1,0 +1,173 @@
+//! Four f32 lanes: SSE on x86-64 (always present there), plain arrays
+//! elsewhere. Both implementations give bit-identical results, including the
+//! NaN rule that matters for the slab test: `max(a, b)` and `min(a, b)`
+//! return `b` when either is NaN (the SSE `maxps`/`minps` definition).
+
+// The intrinsics below carry `#[target_feature(enable = "sse")]`, so calling
+// them is `unsafe` even though SSE is part of every x86-64 CPU: each call's
+// SAFETY note says just that.
+#[cfg(target_arch = "x86_64")]
+mod imp {
+    use core::arch::x86_64::*;
+
+    /// Four f32 lanes.
+    #[derive(Clone, Copy, Debug)]
+    #[repr(transparent)]
+    pub(crate) struct F32x4(__m128);
+
+    impl F32x4 {
+        #[inline(always)]
+        pub(crate) fn splat(x: f32) -> Self {
+            // SAFETY: SSE is in the x86-64 baseline.
+            Self(unsafe { _mm_set1_ps(x) })
+        }
+        #[inline(always)]
+        pub(crate) fn from_array(a: [f32; 4]) -> Self {
+            Self(bytemuck::cast(a))
+        }
+        #[inline(always)]
+        pub(crate) fn to_array(self) -> [f32; 4] {
+            bytemuck::cast(self.0)
+        }
+        #[inline(always)]
+        pub(crate) fn add(self, o: Self) -> Self {
+            // SAFETY: SSE is in the x86-64 baseline.
+            Self(unsafe { _mm_add_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        pub(crate) fn sub(self, o: Self) -> Self {
+            // SAFETY: SSE is in the x86-64 baseline.
+            Self(unsafe { _mm_sub_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        pub(crate) fn mul(self, o: Self) -> Self {
+            // SAFETY: SSE is in the x86-64 baseline.
+            Self(unsafe { _mm_mul_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        pub(crate) fn div(self, o: Self) -> Self {
+            // SAFETY: SSE is in the x86-64 baseline.
+            Self(unsafe { _mm_div_ps(self.0, o.0) })
+        }
+        /// `self` if `self > o`, else `o` (so NaN in either gives `o`).
+        #[inline(always)]
+        pub(crate) fn max(self, o: Self) -> Self {
+            // SAFETY: SSE is in the x86-64 baseline.
+            Self(unsafe { _mm_max_ps(self.0, o.0) })
+        }
+        /// `self` if `self < o`, else `o` (so NaN in either gives `o`).
+        #[inline(always)]
+        pub(crate) fn min(self, o: Self) -> Self {
+            // SAFETY: SSE is in the x86-64 baseline.
+            Self(unsafe { _mm_min_ps(self.0, o.0) })
+        }
+        /// Bit `i` set where lane `i` has `self <= o` (false for NaN).
+        #[inline(always)]
+        pub(crate) fn le_mask(self, o: Self) -> u32 {
+            // SAFETY: SSE is in the x86-64 baseline.
+            (unsafe { _mm_movemask_ps(_mm_cmple_ps(self.0, o.0)) }) as u32
+        }
+        /// Bit `i` set where lane `i` has `self < o`.
+        #[inline(always)]
+        pub(crate) fn lt_mask(self, o: Self) -> u32 {
+            // SAFETY: SSE is in the x86-64 baseline.
+            (unsafe { _mm_movemask_ps(_mm_cmplt_ps(self.0, o.0)) }) as u32
+        }
+        /// Bit `i` set where lane `i` has `self == o`.
+        #[inline(always)]
+        pub(crate) fn eq_mask(self, o: Self) -> u32 {
+            // SAFETY: SSE is in the x86-64 baseline.
+            (unsafe { _mm_movemask_ps(_mm_cmpeq_ps(self.0, o.0)) }) as u32
+        }
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+mod imp {
+    /// Four f32 lanes.
+    #[derive(Clone, Copy, Debug)]
+    #[repr(C, align(16))]
+    pub(crate) struct F32x4([f32; 4]);
+
+    impl F32x4 {
+        #[inline(always)]
+        pub(crate) fn splat(x: f32) -> Self {
+            Self([x; 4])
+        }
+        #[inline(always)]
+        pub(crate) fn from_array(a: [f32; 4]) -> Self {
+            Self(a)
+        }
+        #[inline(always)]
+        pub(crate) fn to_array(self) -> [f32; 4] {
+            self.0
+        }
+        #[inline(always)]
+        fn zip(self, o: Self, f: impl Fn(f32, f32) -> f32) -> Self {
+            Self(core::array::from_fn(|i| f(self.0[i], o.0[i])))
+        }
+        #[inline(always)]
+        fn mask(self, o: Self, f: impl Fn(f32, f32) -> bool) -> u32 {
+            (0..4).fold(0, |m, i| m | (u32::from(f(self.0[i], o.0[i])) << i))
+        }
+        #[inline(always)]
+        pub(crate) fn add(self, o: Self) -> Self {
+            self.zip(o, |a, b| a + b)
+        }
+        #[inline(always)]
+        pub(crate) fn sub(self, o: Self) -> Self {
+            self.zip(o, |a, b| a - b)
+        }
+        #[inline(always)]
+        pub(crate) fn mul(self, o: Self) -> Self {
+            self.zip(o, |a, b| a * b)
+        }
+        #[inline(always)]
+        pub(crate) fn div(self, o: Self) -> Self {
+            self.zip(o, |a, b| a / b)
+        }
+        #[inline(always)]
+        pub(crate) fn max(self, o: Self) -> Self {
+            self.zip(o, |a, b| if a > b { a } else { b })
+        }
+        #[inline(always)]
+        pub(crate) fn min(self, o: Self) -> Self {
+            self.zip(o, |a, b| if a < b { a } else { b })
+        }
+        #[inline(always)]
+        pub(crate) fn le_mask(self, o: Self) -> u32 {
+            self.mask(o, |a, b| a <= b)
+        }
+        #[inline(always)]
+        pub(crate) fn lt_mask(self, o: Self) -> u32 {
+            self.mask(o, |a, b| a < b)
+        }
+        #[inline(always)]
+        pub(crate) fn eq_mask(self, o: Self) -> u32 {
+            self.mask(o, |a, b| a == b)
+        }
+    }
+}
+
+pub(crate) use imp::F32x4;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nan_rule_and_masks() {
+        let a = F32x4::from_array([1.0, f32::NAN, 3.0, -0.0]);
+        let b = F32x4::from_array([2.0, 5.0, f32::NAN, 0.0]);
+        let mx = a.max(b).to_array();
+        assert_eq!(mx[0], 2.0);
+        assert_eq!(mx[1], 5.0);
+        assert!(mx[2].is_nan());
+        assert_eq!(a.min(b).to_array()[1], 5.0);
+        assert_eq!(a.le_mask(b), 0b1001);
+        assert_eq!(a.lt_mask(b), 0b0001);
+        assert_eq!(a.eq_mask(b), 0b1000);
+        let s = a.add(b).mul(F32x4::splat(2.0)).sub(b).div(F32x4::splat(1.0)).to_array();
+        assert_eq!(s[0], 4.0);
+    }
+}

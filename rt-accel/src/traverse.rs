@@ -1,0 +1,253 @@
+//! Closest-hit and occlusion traversal of a borrowed BVH: no std, no
+//! allocation, a fixed stack.
+
+use rt_core::{Aabb, Hit, Ray, SLAB_FAR_SCALE, SceneQuery};
+
+use crate::{
+    RayCtx,
+    node::{ChildRef, Node},
+    prim::{BestHit, Primitive},
+    simd::F32x4,
+};
+
+/// Deepest tree accepted by builders and loaders (root = depth 1).
+pub const MAX_DEPTH: usize = 64;
+/// Traversal stack entries: each level pushes at most three siblings.
+pub const STACK_SIZE: usize = 3 * MAX_DEPTH + 1;
+
+/// A BVH borrowed from memory: nodes, leaf items and the number of
+/// primitives their ids refer to. Built by [`crate::Bvh::as_ref`] or
+/// [`BvhRef::from_bytes`], which check every invariant the traversal relies
+/// on, so traversal never reads out of bounds and always terminates.
+#[derive(Debug)]
+pub struct BvhRef<'a, P: Primitive> {
+    pub(crate) nodes: &'a [Node],
+    pub(crate) items: &'a [P],
+    pub(crate) prim_count: u32,
+}
+
+impl<P: Primitive> Clone for BvhRef<'_, P> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<P: Primitive> Copy for BvhRef<'_, P> {}
+
+/// Traversal statistics for one ray.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraversalStats {
+    /// Inner nodes whose four boxes were tested.
+    pub nodes: u32,
+    /// Leaf items tested.
+    pub items: u32,
+}
+
+impl<'a, P: Primitive> BvhRef<'a, P> {
+    /// The nodes (root first; empty for an empty BVH).
+    #[must_use]
+    pub fn nodes(&self) -> &'a [Node] {
+        self.nodes
+    }
+
+    /// The leaf items in leaf order.
+    #[must_use]
+    pub fn items(&self) -> &'a [P] {
+        self.items
+    }
+
+    /// Number of primitives the items refer to.
+    #[must_use]
+    pub fn prim_count(&self) -> u32 {
+        self.prim_count
+    }
+
+    /// The box around everything (empty for an empty BVH).
+    #[must_use]
+    pub fn bounds(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::EMPTY, Node::bounds)
+    }
+
+    /// The closest hit in `[ray.t_min, ray.t_max]`; ties in `t` go to the
+    /// lower primitive index. Invalid rays ([`Ray::is_valid`]) miss.
+    #[must_use]
+    pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        let ctx = RayCtx::new(ray)?;
+        let best = self.closest_best(&ctx, &mut TraversalStats::default());
+        best.is_hit().then(|| self.items[best.item as usize].hit(best.lane, ray, best.t))?
+    }
+
+    /// Like [`BvhRef::closest_hit`], counting the work done into `stats`.
+    pub fn closest_hit_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
+        let ctx = RayCtx::new(ray)?;
+        let best = self.closest_best(&ctx, stats);
+        best.is_hit().then(|| self.items[best.item as usize].hit(best.lane, ray, best.t))?
+    }
+
+    /// The closest hit's `t`, primitive and leaf position, without the full
+    /// hit record (the cheapest closest-hit query).
+    #[must_use]
+    pub fn closest_t(&self, ray: &Ray) -> Option<BestHit> {
+        let ctx = RayCtx::new(ray)?;
+        let best = self.closest_best(&ctx, &mut TraversalStats::default());
+        best.is_hit().then_some(best)
+    }
+
+    /// Whether anything is hit in `[ray.t_min, ray.t_max]`; stops at the
+    /// first hit found. Invalid rays are not occluded.
+    #[must_use]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        let Some(ctx) = RayCtx::new(ray) else {
+            return false;
+        };
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let t_max = ray.t_max;
+        let tmax4 = F32x4::splat(t_max);
+        let mut stack = [ChildRef::EMPTY; STACK_SIZE];
+        let mut sp = 0;
+        let mut cur = ChildRef::inner(0);
+        loop {
+            if cur.is_leaf() {
+                let (first, count) = cur.leaf_range();
+                for item in &self.items[first..first + count] {
+                    if item.any(&ctx, t_max) {
+                        return true;
+                    }
+                }
+            } else {
+                let node = &self.nodes[cur.index()];
+                let (mask, _) = box_test(node, &ctx, tmax4);
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let c = node.children[i];
+                    if !c.is_empty() {
+                        stack[sp] = c;
+                        sp += 1;
+                    }
+                }
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            cur = stack[sp];
+        }
+    }
+
+    /// The traversal kernel: front-to-back by entry distance, culling
+    /// stacked subtrees that start beyond the best hit.
+    #[inline]
+    fn closest_best(&self, ctx: &RayCtx, stats: &mut TraversalStats) -> BestHit {
+        let mut best = BestHit::new(ctx.ray.t_max);
+        if self.nodes.is_empty() {
+            return best;
+        }
+        let mut stack_ref = [ChildRef::EMPTY; STACK_SIZE];
+        let mut stack_t = [0.0f32; STACK_SIZE];
+        let mut sp = 0;
+        let mut cur = ChildRef::inner(0);
+        'walk: loop {
+            if cur.is_leaf() {
+                let (first, count) = cur.leaf_range();
+                stats.items += count as u32;
+                for (k, item) in self.items[first..first + count].iter().enumerate() {
+                    item.closest((first + k) as u32, ctx, &mut best);
+                }
+            } else {
+                stats.nodes += 1;
+                let node = &self.nodes[cur.index()];
+                // A box entered at (rounded) distance just past the best hit
+                // may still hold an exact tie; widen the bound as the far
+                // planes are widened.
+                let bound = best.t * SLAB_FAR_SCALE;
+                let (mut mask, tnear) = box_test(node, ctx, F32x4::splat(bound));
+                // Gather the hit, non-empty children with their entry distances.
+                let mut refs = [ChildRef::EMPTY; 4];
+                let mut ts = [0.0f32; 4];
+                let mut k = 0;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let c = node.children[i];
+                    if !c.is_empty() {
+                        refs[k] = c;
+                        ts[k] = tnear[i];
+                        k += 1;
+                    }
+                }
+                if k == 1 {
+                    cur = refs[0];
+                    continue 'walk;
+                }
+                if k > 1 {
+                    // Sort descending by entry distance (at most 4: insertion
+                    // sort), push all but the nearest, descend into it.
+                    for a in 1..k {
+                        let (r, t) = (refs[a], ts[a]);
+                        let mut b = a;
+                        while b > 0 && ts[b - 1] < t {
+                            refs[b] = refs[b - 1];
+                            ts[b] = ts[b - 1];
+                            b -= 1;
+                        }
+                        refs[b] = r;
+                        ts[b] = t;
+                    }
+                    for a in 0..k - 1 {
+                        stack_ref[sp] = refs[a];
+                        stack_t[sp] = ts[a];
+                        sp += 1;
+                    }
+                    cur = refs[k - 1];
+                    continue 'walk;
+                }
+            }
+            // Pop the next subtree that can still hold a closer hit.
+            loop {
+                if sp == 0 {
+                    break 'walk;
+                }
+                sp -= 1;
+                if stack_t[sp] <= best.t * SLAB_FAR_SCALE {
+                    cur = stack_ref[sp];
+                    continue 'walk;
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Tests the ray against a node's four boxes (Ize 2013's robust slab test,
+/// see [`rt_core::Aabb::intersect_ray`]). Returns the mask of boxes entered
+/// within `[t_min, t_max]` and the entry distances.
+#[inline(always)]
+fn box_test(node: &Node, ctx: &RayCtx, t_max: F32x4) -> (u32, [f32; 4]) {
+    let b = &node.bounds;
+    let slab = |a: usize| {
+        let near = F32x4::from_array(b[ctx.near[a]]).sub(ctx.org[a]).mul(ctx.inv[a]);
+        let far = F32x4::from_array(b[ctx.far[a]]).sub(ctx.org[a]).mul(ctx.inv[a]);
+        (near, far)
+    };
+    let (nx, fx) = slab(0);
+    let (ny, fy) = slab(1);
+    let (nz, fz) = slab(2);
+    // `x.max(acc)` keeps `acc` when `x` is NaN (a ray in a slab plane).
+    let t0 = nx.max(ny.max(nz.max(ctx.t_min)));
+    let inf = F32x4::splat(f32::INFINITY);
+    let t1 = fx.min(fy.min(fz.min(inf))).mul(ctx.far_scale).min(t_max);
+    (t0.le_mask(t1), t0.to_array())
+}
+
+impl<P: Primitive> SceneQuery for BvhRef<'_, P> {
+    fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        BvhRef::closest_hit(self, ray)
+    }
+
+    fn occluded(&self, ray: &Ray) -> bool {
+        BvhRef::occluded(self, ray)
+    }
+}

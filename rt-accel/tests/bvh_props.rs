@@ -1,0 +1,174 @@
+//! BVH answers equal brute force; bytes round-trip; refit equals rebuild.
+
+mod support;
+
+use proptest::prelude::*;
+use rt_accel::{
+    BuildParams, BuildQuality, Bvh, TriPacket, build_capsules, build_spheres, build_triangles,
+};
+use rt_core::{
+    Ray,
+    glam::Vec3,
+    intersect::{Capsule, Sphere},
+};
+use support::*;
+
+fn vec3(r: f32) -> impl Strategy<Value = Vec3> {
+    (-r..r, -r..r, -r..r).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+/// Random triangle soup: small triangles scattered in a box, some sharing
+/// vertices.
+fn soup() -> impl Strategy<Value = (Vec<Vec3>, Vec<[u32; 3]>)> {
+    (prop::collection::vec((vec3(10.0), vec3(1.5), vec3(1.5)), 1..120)).prop_map(|tris| {
+        let mut pos = Vec::new();
+        let mut idx = Vec::new();
+        for (i, (c, a, b)) in tris.into_iter().enumerate() {
+            let base = pos.len() as u32;
+            pos.extend([c, c + a, c + b]);
+            // Every third triangle reuses the previous triangle's edge.
+            if i % 3 == 2 && base >= 3 {
+                idx.push([base - 2, base - 1, base]);
+            } else {
+                idx.push([base, base + 1, base + 2]);
+            }
+        }
+        (pos, idx)
+    })
+}
+
+fn ray() -> impl Strategy<Value = Ray> {
+    (vec3(14.0), vec3(1.0), 0.0f32..2.0, prop::bool::ANY).prop_filter_map(
+        "zero dir",
+        |(o, d, tmin, inf)| {
+            if d.length_squared() < 1e-6 {
+                return None;
+            }
+            let t_max = if inf { f32::INFINITY } else { 12.0 };
+            Some(Ray::with_range(o, d, tmin, t_max))
+        },
+    )
+}
+
+fn quality() -> impl Strategy<Value = BuildParams> {
+    (0usize..6, 1u32..=16)
+        .prop_map(|(q, leaf)| BuildParams { quality: BuildQuality::ALL[q], max_leaf_size: leaf })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, rng_seed: proptest::test_runner::RngSeed::Fixed(7), failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn triangles_match_brute_force((pos, idx) in soup(), rays in prop::collection::vec(ray(), 64), p in quality()) {
+        let bvh = build_triangles(&pos, &idx, &p).unwrap();
+        for r in &rays {
+            let want = brute_triangles(&pos, &idx, r);
+            prop_assert_eq!(bvh_t(&bvh, r), want);
+            prop_assert_eq!(bvh.occluded(r), want.is_some());
+            if let Some(h) = bvh.closest_hit(r) {
+                prop_assert_eq!((h.t, h.prim), want.unwrap());
+            }
+        }
+    }
+
+    #[test]
+    fn spheres_match_brute_force(
+        s in prop::collection::vec((vec3(10.0), 0.05f32..2.0).prop_map(|(c, r)| Sphere::new(c, r)), 1..100),
+        rays in prop::collection::vec(ray(), 64),
+        p in quality(),
+    ) {
+        let bvh = build_spheres(&s, &p).unwrap();
+        for r in &rays {
+            let want = brute_spheres(&s, r);
+            prop_assert_eq!(bvh_t(&bvh, r), want);
+            prop_assert_eq!(bvh.occluded(r), want.is_some());
+        }
+    }
+
+    #[test]
+    fn capsules_match_brute_force(
+        c in prop::collection::vec((vec3(10.0), vec3(2.0), 0.05f32..1.0).prop_map(|(a, d, r)| Capsule::new(a, a + d, r)), 1..100),
+        rays in prop::collection::vec(ray(), 64),
+        p in quality(),
+    ) {
+        let bvh = build_capsules(&c, &p).unwrap();
+        for r in &rays {
+            let want = brute_capsules(&c, r);
+            prop_assert_eq!(bvh_t(&bvh, r), want);
+            prop_assert_eq!(bvh.occluded(r), want.is_some());
+        }
+    }
+
+    #[test]
+    fn bytes_round_trip_answers_identically((pos, idx) in soup(), rays in prop::collection::vec(ray(), 32)) {
+        let bvh = build_triangles(&pos, &idx, &params()).unwrap();
+        let bytes = bvh.to_bytes();
+        let copied = Bvh::<TriPacket>::from_bytes(&bytes).unwrap();
+        prop_assert_eq!(&copied, &bvh);
+        // Zero-copy view over an aligned copy of the bytes.
+        let mut aligned = vec![0u128; bytes.len().div_ceil(16)];
+        bytemuck::cast_slice_mut::<u128, u8>(&mut aligned)[..bytes.len()].copy_from_slice(&bytes);
+        let view = rt_accel::BvhRef::<TriPacket>::from_bytes(&bytemuck::cast_slice(&aligned)[..bytes.len()]).unwrap();
+        for r in &rays {
+            prop_assert_eq!(copied.closest_hit(r), bvh.closest_hit(r));
+            prop_assert_eq!(view.closest_hit(r), bvh.closest_hit(r));
+            prop_assert_eq!(view.occluded(r), bvh.occluded(r));
+        }
+    }
+
+    #[test]
+    fn refit_answers_like_a_fresh_build(
+        (pos, idx) in soup(),
+        shift in prop::collection::vec(vec3(3.0), 1..8),
+        rays in prop::collection::vec(ray(), 48),
+    ) {
+        let mut bvh = build_triangles(&pos, &idx, &params()).unwrap();
+        // Move every vertex (a deformation, not a rigid motion).
+        let moved: Vec<Vec3> = pos.iter().enumerate().map(|(i, p)| *p + shift[i % shift.len()] * (1.0 + (i % 5) as f32 * 0.1)).collect();
+        bvh.refit_triangles(&moved, &idx).unwrap();
+        for r in &rays {
+            // Triangles that became degenerate stay in a refit tree but are
+            // never hit by brute force either (det = 0), so answers agree.
+            prop_assert_eq!(bvh_t(&bvh, r), brute_triangles(&moved, &idx, r));
+            prop_assert_eq!(bvh.occluded(r), brute_triangles(&moved, &idx, r).is_some());
+        }
+        // And the refit tree is still well formed.
+        prop_assert!(Bvh::<TriPacket>::from_bytes(&bvh.to_bytes()).is_ok());
+    }
+}
+
+#[test]
+fn empty_inputs_build_empty_bvhs_that_miss() {
+    let r = Ray::new(Vec3::ZERO, Vec3::X);
+    let t = build_triangles(&[], &[], &params()).unwrap();
+    assert!(t.closest_hit(&r).is_none() && !t.occluded(&r));
+    let s = build_spheres(&[], &params()).unwrap();
+    assert!(s.closest_hit(&r).is_none());
+    let bytes = t.to_bytes();
+    assert_eq!(Bvh::<TriPacket>::from_bytes(&bytes).unwrap(), t);
+}
+
+#[test]
+fn bad_input_is_an_error_naming_it() {
+    use rt_accel::BuildError;
+    let pos = [Vec3::ZERO, Vec3::X, Vec3::new(f32::NAN, 0.0, 0.0), Vec3::Y];
+    assert_eq!(
+        build_triangles(&pos, &[[0, 1, 3], [0, 2, 3]], &params()),
+        Err(BuildError::NonFiniteVertex { vertex: 2 })
+    );
+    assert_eq!(
+        build_triangles(&pos, &[[0, 1, 3], [0, 1, 9]], &params()),
+        Err(BuildError::IndexOutOfRange { triangle: 1, index: 9 })
+    );
+    let s = [Sphere::new(Vec3::ZERO, 1.0), Sphere::new(Vec3::ZERO, -1.0)];
+    assert_eq!(build_spheres(&s, &params()), Err(BuildError::InvalidPrimitive { index: 1 }));
+    let c = [Capsule::new(Vec3::ZERO, Vec3::splat(f32::INFINITY), 1.0)];
+    assert_eq!(build_capsules(&c, &params()), Err(BuildError::InvalidPrimitive { index: 0 }));
+    let mut bvh = build_triangles(&pos, &[[0, 1, 3]], &params()).unwrap();
+    let before = bvh.clone();
+    assert_eq!(
+        bvh.refit_triangles(&pos, &[[0, 2, 3]]),
+        Err(BuildError::NonFiniteVertex { vertex: 2 })
+    );
+    assert_eq!(bvh, before, "a failed refit changes nothing");
+}
