@@ -36,6 +36,7 @@ pub struct Header {
 }
 
 impl Header {
+    #[cfg(feature = "alloc")]
     pub(crate) fn new<P: Primitive>(nodes: usize, items: usize, prims: u32) -> Self {
         Self {
             magic: MAGIC,

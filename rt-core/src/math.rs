@@ -15,6 +15,7 @@ mod imp {
         x.tan()
     }
     #[inline]
+    #[cfg_attr(not(feature = "alloc"), allow(dead_code, reason = "used by `Frame` only"))]
     pub(crate) fn powf(x: f32, y: f32) -> f32 {
         x.powf(y)
     }
@@ -47,6 +48,7 @@ mod imp {
         libm::tanf(x)
     }
     #[inline]
+    #[cfg_attr(not(feature = "alloc"), allow(dead_code, reason = "used by `Frame` only"))]
     pub(crate) fn powf(x: f32, y: f32) -> f32 {
         libm::powf(x, y)
     }

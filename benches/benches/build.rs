@@ -1,0 +1,21 @@
+//! Criterion: BVH build time per obvhs preset.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use rt_accel::{BuildParams, BuildQuality, build_triangles};
+use rt_benches::scenes;
+
+fn build(c: &mut Criterion) {
+    let mesh = scenes::icosphere(5);
+    let mut g = c.benchmark_group("build_icosphere5");
+    g.sample_size(10);
+    for q in &BuildQuality::ALL[..5] {
+        let p = BuildParams { quality: *q, max_leaf_size: 4 };
+        g.bench_function(q.name(), |b| {
+            b.iter(|| build_triangles(&mesh.positions, &mesh.indices, &p).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, build);
+criterion_main!(benches);

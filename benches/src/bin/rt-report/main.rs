@@ -1,0 +1,45 @@
+//! `rt-report`: run time against error, per area, as tables and CSV files
+//! under `target/rt-report/`.
+//!
+//! ```text
+//! cargo run --release -p rt-benches --bin rt-report -- traversal [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- all [--quick]
+//! ```
+
+mod timing;
+mod traversal;
+
+use std::{path::PathBuf, process::ExitCode};
+
+/// Where reports go: `$CARGO_TARGET_DIR/rt-report` or `target/rt-report` at
+/// the workspace root.
+fn out_dir() -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..").join("target"));
+    target.join("rt-report")
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let areas: Vec<&str> =
+        args.iter().filter(|a| !a.starts_with("--")).map(String::as_str).collect();
+    let areas = if areas.is_empty() || areas == ["all"] { vec!["traversal"] } else { areas };
+    let dir = out_dir();
+    if let Err(e) = std::fs::create_dir_all(&dir) {
+        eprintln!("cannot create {}: {e}", dir.display());
+        return ExitCode::FAILURE;
+    }
+    for area in areas {
+        let result = match area {
+            "traversal" => traversal::run(&dir, quick),
+            other => Err(format!("unknown area `{other}` (known: traversal, all)")),
+        };
+        if let Err(e) = result {
+            eprintln!("rt-report {area}: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
+    ExitCode::SUCCESS
+}

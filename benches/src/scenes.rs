@@ -1,0 +1,169 @@
+//! Deterministic scenes and ray sets.
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+use rt_core::{Camera, Projection, Ray, glam::Vec2, sampling};
+
+/// An indexed triangle mesh.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Triangles.
+    pub indices: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    /// Bounds `(min, max)` of the vertices.
+    #[must_use]
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let init = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        self.positions.iter().fold(init, |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+    }
+}
+
+/// Smooth value noise in `[-1, 1]` from an integer-lattice hash.
+fn value_noise(x: f32, y: f32, seed: u64) -> f32 {
+    let h = |i: i64, j: i64| {
+        let k = sampling::mix64(seed ^ (i as u64).wrapping_mul(0x9e37_79b9) ^ (j as u64) << 32);
+        (k >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+    };
+    let (i, j) = (x.floor() as i64, y.floor() as i64);
+    let (fx, fy) = (x - x.floor(), y - y.floor());
+    let s = |t: f32| t * t * (3.0 - 2.0 * t);
+    let (sx, sy) = (s(fx), s(fy));
+    let a = h(i, j) + sx * (h(i + 1, j) - h(i, j));
+    let b = h(i, j + 1) + sx * (h(i + 1, j + 1) - h(i, j + 1));
+    a + sy * (b - a)
+}
+
+/// A noisy height field over `[-1, 1]²` with `n × n` vertices
+/// (`2 (n − 1)²` triangles): fractal value noise, five octaves.
+#[must_use]
+pub fn terrain(n: u32) -> Mesh {
+    let mut positions = Vec::with_capacity((n * n) as usize);
+    for j in 0..n {
+        for i in 0..n {
+            let x = 2.0 * i as f32 / (n - 1) as f32 - 1.0;
+            let y = 2.0 * j as f32 / (n - 1) as f32 - 1.0;
+            let mut h = 0.0;
+            let mut amp = 0.25;
+            let mut freq = 2.0;
+            for o in 0..5 {
+                h += amp * value_noise(x * freq, y * freq, 17 + o);
+                amp *= 0.5;
+                freq *= 2.0;
+            }
+            positions.push(Vec3::new(x, h, y));
+        }
+    }
+    let mut indices = Vec::with_capacity((2 * (n - 1) * (n - 1)) as usize);
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let a = j * n + i;
+            let (b, c, d) = (a + 1, a + n, a + n + 1);
+            indices.push([a, c, b]);
+            indices.push([b, c, d]);
+        }
+    }
+    Mesh { positions, indices }
+}
+
+/// The unit icosphere subdivided `level` times (`20 · 4^level` triangles).
+#[must_use]
+pub fn icosphere(level: u32) -> Mesh {
+    let t = (1.0 + 5.0f32.sqrt()) / 2.0;
+    let base = [
+        (-1.0, t, 0.0),
+        (1.0, t, 0.0),
+        (-1.0, -t, 0.0),
+        (1.0, -t, 0.0),
+        (0.0, -1.0, t),
+        (0.0, 1.0, t),
+        (0.0, -1.0, -t),
+        (0.0, 1.0, -t),
+        (t, 0.0, -1.0),
+        (t, 0.0, 1.0),
+        (-t, 0.0, -1.0),
+        (-t, 0.0, 1.0),
+    ];
+    let mut positions: Vec<Vec3> =
+        base.iter().map(|&(x, y, z)| Vec3::new(x, y, z).normalize()).collect();
+    let mut indices: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..level {
+        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut next = Vec::with_capacity(indices.len() * 4);
+        let mut midpoint = |a: u32, b: u32, pos: &mut Vec<Vec3>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                pos.push(((pos[a as usize] + pos[b as usize]) * 0.5).normalize());
+                pos.len() as u32 - 1
+            })
+        };
+        for [a, b, c] in indices {
+            let ab = midpoint(a, b, &mut positions);
+            let bc = midpoint(b, c, &mut positions);
+            let ca = midpoint(c, a, &mut positions);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        indices = next;
+    }
+    Mesh { positions, indices }
+}
+
+/// `width × height` primary rays (pixel centres) of a perspective camera
+/// at `eye` looking at `target`.
+#[must_use]
+pub fn primary_rays(eye: Vec3, target: Vec3, width: u32, height: u32) -> Vec<Ray> {
+    let p = Projection::Perspective { fov_y: 50f32.to_radians() };
+    let cam = Camera::look_at(eye, target, Vec3::Y, p, width, height).expect("valid camera");
+    let mut rays = Vec::with_capacity((width * height) as usize);
+    for y in 0..height {
+        for x in 0..width {
+            rays.push(cam.generate_ray(x, y, Vec2::splat(0.5), Vec2::ZERO));
+        }
+    }
+    rays
+}
+
+/// `count` incoherent rays: origins uniform in the box `(lo, hi)`,
+/// directions uniform on the sphere, from `seed`.
+#[must_use]
+pub fn incoherent_rays(lo: Vec3, hi: Vec3, count: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = sampling::rng_from_seed(seed);
+    (0..count)
+        .map(|_| {
+            let u = Vec3::new(
+                sampling::uniform(&mut rng),
+                sampling::uniform(&mut rng),
+                sampling::uniform(&mut rng),
+            );
+            let o = lo + (hi - lo) * u;
+            let z = 1.0 - 2.0 * sampling::uniform(&mut rng);
+            let phi = std::f32::consts::TAU * sampling::uniform(&mut rng);
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            Ray::new(o, Vec3::new(r * phi.cos(), r * phi.sin(), z))
+        })
+        .collect()
+}
