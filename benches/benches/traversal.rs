@@ -1,5 +1,9 @@
 //! Criterion: closest-hit and occlusion traversal of primary and
 //! incoherent rays.
+// A std-only tool crate: the no_std import lints guard the libraries.
+#![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
+// criterion_group! generates undocumented items.
+#![allow(missing_docs)]
 
 use std::hint::black_box;
 

@@ -80,7 +80,10 @@ pub struct BuildParams {
     /// obvhs preset.
     pub quality: BuildQuality,
     /// Most primitives per leaf, `1..=16` (clamped). Triangles are tested
-    /// four at a time, so 4 suits them.
+    /// four at a time; leaves of up to 8 (two packets) make the tree
+    /// shallower, which pays for incoherent rays (`rt-report traversal`:
+    /// leaf 4 → 8 took incoherent rays from 0.92–0.95× to 1.0–1.05× of
+    /// obvhs's CWBVH, primary rays unchanged).
     pub max_leaf_size: u32,
 }
 
@@ -88,19 +91,19 @@ impl BuildParams {
     /// Quick builds for geometry that changes every frame.
     #[must_use]
     pub const fn fast() -> Self {
-        Self { quality: BuildQuality::Fast, max_leaf_size: 4 }
+        Self { quality: BuildQuality::Fast, max_leaf_size: 8 }
     }
 
     /// The default: good traversal for a moderate build time.
     #[must_use]
     pub const fn medium() -> Self {
-        Self { quality: BuildQuality::Medium, max_leaf_size: 4 }
+        Self { quality: BuildQuality::Medium, max_leaf_size: 8 }
     }
 
     /// Best traversal, slow build.
     #[must_use]
     pub const fn slow() -> Self {
-        Self { quality: BuildQuality::Slow, max_leaf_size: 4 }
+        Self { quality: BuildQuality::Slow, max_leaf_size: 8 }
     }
 
     fn obvhs(&self) -> BvhBuildParams {
@@ -229,8 +232,9 @@ fn to_aabb(b: &obvhs::aabb::Aabb) -> Aabb {
 
 /// Collapses a binary BVH into the 4-wide layout: each wide node takes its
 /// binary node's two children and repeatedly opens the inner child of
-/// largest surface area until it has four. Nodes are emitted depth first,
-/// so children always follow their parent.
+/// largest surface area until it has four. Nodes are emitted breadth
+/// first (the order [`crate::validate`] checks), so children always follow
+/// their parent.
 fn convert<P: Primitive>(
     bvh2: Option<&Bvh2>,
     mut emit_leaf: impl FnMut(&[u32], &mut Vec<P>),
@@ -244,8 +248,11 @@ fn convert<P: Primitive>(
         return Ok((nodes, items));
     }
     nodes.push(Node::EMPTY);
-    let mut work = alloc::vec![(0usize, 0usize, 1usize)];
-    while let Some((src, dst, depth)) = work.pop() {
+    // `work[i]` = (binary node, depth) of wide node `i`; processing in index
+    // order while appending children gives breadth-first order.
+    let mut work = alloc::vec![(0usize, 1usize)];
+    let mut dst = 0;
+    while let Some(&(src, depth)) = work.get(dst) {
         if depth > MAX_DEPTH {
             return Err(BuildError::TooDeep);
         }
@@ -292,11 +299,12 @@ fn convert<P: Primitive>(
             } else {
                 let idx = nodes.len();
                 nodes.push(Node::EMPTY);
-                work.push((k, idx, depth + 1));
+                work.push((k, depth + 1));
                 ChildRef::inner(idx as u32)
             };
         }
         nodes[dst] = node;
+        dst += 1;
     }
     Ok((nodes, items))
 }

@@ -5,7 +5,7 @@
 //! and every invariant traversal relies on (see [`validate`]), so a
 //! malformed blob is an `Err`, never a panic or an out-of-bounds read.
 
-use crate::{LoadError, MAX_DEPTH, STACK_SIZE, node::Node, prim::Primitive, traverse::BvhRef};
+use crate::{LoadError, MAX_DEPTH, node::Node, prim::Primitive, traverse::BvhRef};
 
 /// Magic bytes opening every serialized BVH.
 pub const MAGIC: [u8; 8] = *b"rtBVH4\0\0";
@@ -115,11 +115,12 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     }
 }
 
-/// Checks what traversal relies on: every inner child reference points
-/// after its parent and inside the node array; every leaf range lies inside
-/// the item array; each node is reached exactly once from the root (a
-/// tree); depth ≤ [`MAX_DEPTH`]; every item is well formed. Runs in linear
-/// time with a fixed stack, without allocating.
+/// Checks what traversal relies on: nodes are in breadth-first order, so
+/// the inner children met scanning nodes `0, 1, 2, …` (slots in order) are
+/// exactly nodes `1, 2, 3, …`, each once: that makes the nodes a tree with
+/// every child after its parent. Leaf ranges lie inside the item array;
+/// depth ≤ [`MAX_DEPTH`]; every item is well formed. Linear time, constant
+/// memory, no allocation.
 ///
 /// # Errors
 /// [`LoadError`] naming the first problem found.
@@ -134,41 +135,44 @@ pub fn validate<P: Primitive>(
     if nodes.is_empty() {
         return if items.is_empty() { Ok(()) } else { Err(LoadError::NotATree) };
     }
-    let mut stack = [(0u32, 0u8); STACK_SIZE + 4];
-    stack[0] = (0, 1);
-    let mut sp = 1;
-    let mut visited = 0usize;
-    while sp > 0 {
-        sp -= 1;
-        let (idx, depth) = stack[sp];
-        let idx = idx as usize;
-        visited += 1;
-        if visited > nodes.len() {
+    // `next`: the index the next inner child reference must have. Nodes in
+    // `[level_start, level_end)` form one level of the tree.
+    let mut next = 1;
+    let (mut depth, mut level_end) = (1, 1);
+    for (i, node) in nodes.iter().enumerate() {
+        if i >= next {
+            // Nothing refers to node i.
             return Err(LoadError::NotATree);
         }
-        for c in nodes[idx].children {
+        if i == level_end {
+            depth += 1;
+            level_end = next;
+        }
+        if depth > MAX_DEPTH {
+            return Err(LoadError::TooDeep);
+        }
+        for c in node.children {
             if c.is_empty() {
                 continue;
             }
             if c.is_leaf() {
                 let (first, count) = c.leaf_range();
                 if first + count > items.len() {
-                    return Err(LoadError::LeafOutOfRange { node: idx });
+                    return Err(LoadError::LeafOutOfRange { node: i });
                 }
             } else {
                 let ci = c.index();
-                if ci <= idx || ci >= nodes.len() {
-                    return Err(LoadError::BadChild { node: idx });
+                if ci <= i || ci >= nodes.len() {
+                    return Err(LoadError::BadChild { node: i });
                 }
-                if depth as usize >= MAX_DEPTH {
-                    return Err(LoadError::TooDeep);
+                if ci != next {
+                    return Err(LoadError::NotATree);
                 }
-                stack[sp] = (ci as u32, depth + 1);
-                sp += 1;
+                next += 1;
             }
         }
     }
-    if visited != nodes.len() {
+    if next != nodes.len() {
         return Err(LoadError::NotATree);
     }
     Ok(())

@@ -68,7 +68,8 @@ pub trait Primitive: bytemuck::Pod + Sealed {
     /// Whether any primitive of the item is hit with `t ∈ [t_min, t_max]`.
     fn any(&self, ray: &RayCtx, t_max: f32) -> bool;
     /// The full hit record for `lane`, whose hit at parameter `t` was found
-    /// by [`Primitive::closest`].
+    /// by [`Primitive::closest`] for `ray` (re-run with `t_max = t`, so the
+    /// same arithmetic finds the same hit).
     fn hit(&self, lane: u32, ray: &Ray, t: f32) -> Option<Hit>;
     /// The box around the item's primitives.
     fn bounds(&self) -> Aabb;
@@ -123,13 +124,12 @@ impl Primitive for SphereItem {
     }
 
     fn hit(&self, _lane: u32, ray: &Ray, t: f32) -> Option<Hit> {
-        let r = Ray::with_range(ray.origin, ray.direction, t, t);
+        let r = Ray { t_max: t, ..*ray };
         intersect_sphere(&r, &self.sphere, self.prim)
     }
 
     fn bounds(&self) -> Aabb {
-        let r = glam::Vec3::splat(self.sphere.radius);
-        Aabb::new(self.sphere.center - r, self.sphere.center + r)
+        self.sphere.bounds()
     }
 
     fn is_well_formed(&self, prim_count: u32) -> bool {
@@ -156,14 +156,12 @@ impl Primitive for CapsuleItem {
     }
 
     fn hit(&self, _lane: u32, ray: &Ray, t: f32) -> Option<Hit> {
-        let r = Ray::with_range(ray.origin, ray.direction, t, t);
+        let r = Ray { t_max: t, ..*ray };
         intersect_capsule(&r, &self.capsule, self.prim)
     }
 
     fn bounds(&self) -> Aabb {
-        let c = &self.capsule;
-        let r = glam::Vec3::splat(c.radius);
-        Aabb::new(c.p0 - r, c.p0 + r).union(Aabb::new(c.p1 - r, c.p1 + r))
+        self.capsule.bounds()
     }
 
     fn is_well_formed(&self, prim_count: u32) -> bool {

@@ -1,6 +1,6 @@
 //! Per-ray constants shared by the box tests and the leaf tests.
 
-use rt_core::{Ray, SLAB_FAR_SCALE, intersect::WatertightRay};
+use rt_core::{Ray, SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG, intersect::WatertightRay};
 
 use crate::simd::F32x4;
 
@@ -18,7 +18,9 @@ pub struct RayCtx {
     pub(crate) near: [usize; 3],
     /// Row holding the far plane per axis.
     pub(crate) far: [usize; 3],
-    pub(crate) far_scale: F32x4,
+    /// `1 ± 2γ(3)`: far distances are widened outward by rounding bounds.
+    pub(crate) far_up: F32x4,
+    pub(crate) far_down: F32x4,
     pub(crate) t_min: F32x4,
     /// Watertight shear constants for triangles.
     pub(crate) wt: WatertightRay,
@@ -55,7 +57,8 @@ impl RayCtx {
             inv: [F32x4::splat(inv.x), F32x4::splat(inv.y), F32x4::splat(inv.z)],
             near: [nx, ny, nz],
             far: [fx, fy, fz],
-            far_scale: F32x4::splat(SLAB_FAR_SCALE),
+            far_up: F32x4::splat(SLAB_FAR_SCALE),
+            far_down: F32x4::splat(SLAB_FAR_SCALE_NEG),
             t_min: F32x4::splat(ray.t_min),
             wt,
             wt_org: [F32x4::splat(o[kx]), F32x4::splat(o[ky]), F32x4::splat(o[kz])],

@@ -1,7 +1,7 @@
 //! Refitting after primitives move: same tree, new boxes.
 
 use glam::Vec3;
-use rt_core::intersect::{Capsule, Sphere};
+use rt_core::intersect::{Capsule, Sphere, is_degenerate_triangle};
 
 use crate::{BuildError, Bvh, CapsuleItem, SphereItem, TriPacket, check::triangle_vertices};
 
@@ -9,7 +9,8 @@ impl Bvh<TriPacket> {
     /// Moves every triangle to its new vertices (`indices` must be the list
     /// the BVH was built from, `positions` the moved vertices) and refits
     /// the boxes. Triangles left out at build time as degenerate stay out
-    /// until a rebuild.
+    /// until a rebuild; triangles that become degenerate are never hit
+    /// (their lane collapses to a point) until a refit gives them area.
     ///
     /// # Errors
     /// [`BuildError::RefitMismatch`] if `indices` has a different length,
@@ -30,7 +31,11 @@ impl Bvh<TriPacket> {
             for packet in items {
                 for lane in 0..packet.len() {
                     let idx = indices[packet.prims[lane] as usize];
-                    let verts = idx.map(|i| positions[i as usize]);
+                    let mut verts = idx.map(|i| positions[i as usize]);
+                    if is_degenerate_triangle(verts[0], verts[1], verts[2]) {
+                        // A point triangle: edge functions exactly 0, never hit.
+                        verts = [verts[0]; 3];
+                    }
                     packet.set_lane(lane, packet.prims[lane], verts);
                 }
             }

@@ -151,6 +151,25 @@ mod imp {
 
 pub(crate) use imp::F32x4;
 
+/// Hints the CPU to start loading the first two cache lines of `r`.
+#[inline(always)]
+pub(crate) fn prefetch<T>(r: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let p = (r as *const T).cast::<i8>();
+        // SAFETY: SSE is in the x86-64 baseline; a prefetch never faults,
+        // whatever the address (`wrapping_add` keeps the pointer arithmetic
+        // defined even past the object).
+        unsafe {
+            _mm_prefetch::<{ _MM_HINT_T0 }>(p);
+            _mm_prefetch::<{ _MM_HINT_T0 }>(p.wrapping_add(64));
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = r;
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

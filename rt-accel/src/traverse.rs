@@ -1,13 +1,13 @@
 //! Closest-hit and occlusion traversal of a borrowed BVH: no std, no
 //! allocation, a fixed stack.
 
-use rt_core::{Aabb, Hit, Ray, SLAB_FAR_SCALE, SceneQuery};
+use rt_core::{Aabb, Hit, Ray, SceneQuery, widen_far};
 
 use crate::{
     RayCtx,
     node::{ChildRef, Node},
     prim::{BestHit, Primitive},
-    simd::F32x4,
+    simd::{F32x4, prefetch},
 };
 
 /// Deepest tree accepted by builders and loaders (root = depth 1).
@@ -137,6 +137,17 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         }
     }
 
+    #[inline(always)]
+    fn prefetch(&self, c: ChildRef) {
+        if c.is_leaf() {
+            if let Some(it) = self.items.get(c.leaf_range().0) {
+                prefetch(it);
+            }
+        } else if let Some(n) = self.nodes.get(c.index()) {
+            prefetch(n);
+        }
+    }
+
     /// The traversal kernel: front-to-back by entry distance, culling
     /// stacked subtrees that start beyond the best hit.
     #[inline]
@@ -162,7 +173,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 // A box entered at (rounded) distance just past the best hit
                 // may still hold an exact tie; widen the bound as the far
                 // planes are widened.
-                let bound = best.t * SLAB_FAR_SCALE;
+                let bound = widen_far(best.t);
                 let (mut mask, tnear) = box_test(node, ctx, F32x4::splat(bound));
                 // Gather the hit, non-empty children with their entry distances.
                 let mut refs = [ChildRef::EMPTY; 4];
@@ -197,6 +208,9 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                         ts[b] = t;
                     }
                     for a in 0..k - 1 {
+                        // Start fetching what will be visited after the
+                        // nearest subtree, to overlap the memory latency.
+                        self.prefetch(refs[a]);
                         stack_ref[sp] = refs[a];
                         stack_t[sp] = ts[a];
                         sp += 1;
@@ -211,7 +225,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                     break 'walk;
                 }
                 sp -= 1;
-                if stack_t[sp] <= best.t * SLAB_FAR_SCALE {
+                if stack_t[sp] <= widen_far(best.t) {
                     cur = stack_ref[sp];
                     continue 'walk;
                 }
@@ -238,7 +252,9 @@ fn box_test(node: &Node, ctx: &RayCtx, t_max: F32x4) -> (u32, [f32; 4]) {
     // `x.max(acc)` keeps `acc` when `x` is NaN (a ray in a slab plane).
     let t0 = nx.max(ny.max(nz.max(ctx.t_min)));
     let inf = F32x4::splat(f32::INFINITY);
-    let t1 = fx.min(fy.min(fz.min(inf))).mul(ctx.far_scale).min(t_max);
+    let t1 = fx.min(fy.min(fz.min(inf)));
+    // Widen outward whatever the sign (rt_core::widen_far).
+    let t1 = t1.mul(ctx.far_up).max(t1.mul(ctx.far_down)).min(t_max);
     (t0.le_mask(t1), t0.to_array())
 }
 

@@ -5,12 +5,14 @@
 //! operation, so the BVH and a brute-force loop agree to the bit. Lanes whose
 //! edge function is exactly zero (ray through an edge or vertex) are handed
 //! to the scalar test, which decides them in f64 as Woop et al. prescribe.
-//! Unused lanes hold NaN vertices, which never hit.
+//! Unused lanes hold NaN vertices, which never hit; lanes of triangles
+//! that became degenerate in a refit hold three copies of one point, whose
+//! edge functions are exactly zero, so they never hit either.
 
 use glam::Vec3;
 use rt_core::{
     Aabb, Hit, PrimKind, Ray,
-    intersect::{TriangleHit, intersect_triangle_t, triangle_hit},
+    intersect::{TriangleHit, intersect_triangle_t, triangle_admits_hit, triangle_hit},
 };
 
 use crate::{
@@ -62,6 +64,19 @@ impl TriPacket {
     #[must_use]
     pub fn is_empty(&self) -> bool {
         self.prims[0] == u32::MAX
+    }
+
+    /// The scalar test's final check ([`triangle_admits_hit`]) for a lane
+    /// the SIMD test accepted.
+    #[inline]
+    fn admits(&self, lane: usize, ray: &Ray, t: f32) -> bool {
+        triangle_admits_hit(
+            ray,
+            t,
+            self.vertex(lane, 0),
+            self.vertex(lane, 1),
+            self.vertex(lane, 2),
+        )
     }
 
     #[inline]
@@ -116,7 +131,9 @@ impl Primitive for TriPacket {
         while ok != 0 {
             let lane = ok.trailing_zeros();
             ok &= ok - 1;
-            best.offer(t[lane as usize], self.prims[lane as usize], item, lane);
+            if self.admits(lane as usize, &ctx.ray, t[lane as usize]) {
+                best.offer(t[lane as usize], self.prims[lane as usize], item, lane);
+            }
         }
         if edge != 0 {
             let r = Ray { t_max: best.t, ..ctx.ray };
@@ -132,9 +149,13 @@ impl Primitive for TriPacket {
 
     #[inline]
     fn any(&self, ctx: &RayCtx, t_max: f32) -> bool {
-        let (ok, mut edge, _) = self.lanes(ctx, F32x4::splat(t_max));
-        if ok != 0 {
-            return true;
+        let (mut ok, mut edge, t) = self.lanes(ctx, F32x4::splat(t_max));
+        while ok != 0 {
+            let lane = ok.trailing_zeros() as usize;
+            ok &= ok - 1;
+            if self.admits(lane, &ctx.ray, t[lane]) {
+                return true;
+            }
         }
         let r = Ray { t_max, ..ctx.ray };
         while edge != 0 {
@@ -149,7 +170,7 @@ impl Primitive for TriPacket {
 
     fn hit(&self, lane: u32, ray: &Ray, t: f32) -> Option<Hit> {
         let l = lane as usize;
-        let r = Ray { t_min: t, t_max: t, ..*ray };
+        let r = Ray { t_max: t, ..*ray };
         let ctx = RayCtx::new(&r)?;
         let h = self.scalar(l, &r, &ctx)?;
         Some(triangle_hit(
@@ -177,7 +198,9 @@ impl Primitive for TriPacket {
             if lane < n {
                 self.prims[lane] < prim_count && (0..3).all(|k| self.vertex(lane, k).is_finite())
             } else {
+                // Unused lanes are tested too: they must hold NaN.
                 self.prims[lane] == u32::MAX
+                    && self.v.iter().all(|vk| vk.iter().all(|axis| axis[lane].is_nan()))
             }
         })
     }

@@ -17,9 +17,22 @@ pub struct Aabb {
     pub max: Vec3,
 }
 
-/// `1 + 2γ(3)`: scaling the far slab distance by this makes the slab test
-/// conservative under f32 rounding (Ize 2013, "Robust BVH Ray Traversal").
+/// `1 + 2γ(3)`: scaling a positive far slab distance by this makes the slab
+/// test conservative under f32 rounding (Ize 2013, "Robust BVH Ray
+/// Traversal"); see [`widen_far`] for the signed form.
 pub const SLAB_FAR_SCALE: f32 = 1.0 + 2.0 * gamma(3);
+
+/// `1 − 2γ(3)`: the scale that widens a *negative* far distance.
+pub const SLAB_FAR_SCALE_NEG: f32 = 1.0 - 2.0 * gamma(3);
+
+/// A far slab distance moved outward by its rounding bound, whatever its
+/// sign: `max(t·(1 + 2γ(3)), t·(1 − 2γ(3)))`.
+#[inline]
+#[must_use]
+pub fn widen_far(t: f32) -> f32 {
+    let (a, b) = (t * SLAB_FAR_SCALE, t * SLAB_FAR_SCALE_NEG);
+    if a > b { a } else { b }
+}
 
 impl Aabb {
     /// The empty box.
@@ -91,12 +104,25 @@ impl Aabb {
         e.x * e.y + e.y * e.z + e.z * e.x
     }
 
+    /// Whether a hit at parameter `t` is consistent with this box, the box of
+    /// the primitive hit: the robust slab test admits the ray within
+    /// `[ray.t_min, widen_far(t)]`. Intersection tests apply this to their
+    /// hits, so a hit never lies outside its primitive's box by rounding;
+    /// then a BVH, whose boxes contain the primitives' boxes and whose
+    /// culling uses the same test, finds exactly the hits a brute-force loop
+    /// finds.
+    #[inline]
+    #[must_use]
+    pub fn admits_hit(&self, ray: &Ray, t: f32) -> bool {
+        self.intersect_ray(&Ray { t_max: widen_far(t), ..*ray }).is_some()
+    }
+
     /// The parameter interval `[t0, t1]` where `ray` is inside the box,
     /// clipped to the ray's `[t_min, t_max]`, or `None`.
     ///
     /// The slab test of Kay and Kajiya made robust as Ize (2013) shows: the
     /// far distance is scaled by [`SLAB_FAR_SCALE`] so rounding never causes
-    /// a false miss. Direction components of `±0.0` give reciprocals of `±∞`;
+    /// a false miss (for negative distances too, see [`widen_far`]). Direction components of `±0.0` give reciprocals of `±∞`;
     /// the slab near/far planes are chosen by the sign *bit*, so `−0.0` is
     /// handled like any negative direction. A ray lying exactly in a slab's
     /// plane gives `0·∞ = NaN` for that plane; the comparisons below are
@@ -117,7 +143,7 @@ impl Aabb {
                 (self.min[a], self.max[a])
             };
             let near = (lo - ray.origin[a]) * inv[a];
-            let far = (hi - ray.origin[a]) * inv[a] * SLAB_FAR_SCALE;
+            let far = widen_far((hi - ray.origin[a]) * inv[a]);
             // `x > t0` is false for NaN, so NaN leaves the bound alone.
             if near > t0 {
                 t0 = near;
@@ -187,6 +213,17 @@ mod tests {
         let b = Aabb::new(Vec3::new(0.1, -1.0, -1.0), Vec3::new(0.1, 1.0, 1.0));
         let r = Ray::new(Vec3::new(-0.3, 0.0, 0.0), Vec3::new(0.7, 0.1, 0.0));
         assert!(b.intersect_ray(&r).is_some());
+    }
+
+    #[test]
+    fn flat_box_behind_the_origin_is_found_with_negative_t_min() {
+        // The box lies at negative t; the far distance is negative and must
+        // be widened toward +∞ (a plain scale by 1 + 2γ would shrink it).
+        let b = Aabb::new(Vec3::new(-0.3, -1.0, -1.0), Vec3::new(-0.3, 1.0, 1.0));
+        let r = Ray::with_range(Vec3::new(0.1, 0.0, 0.0), Vec3::new(0.7, 0.1, 0.0), -10.0, 10.0);
+        assert!(b.intersect_ray(&r).is_some());
+        assert_eq!(widen_far(-2.0), -2.0 * SLAB_FAR_SCALE_NEG);
+        assert_eq!(widen_far(2.0), 2.0 * SLAB_FAR_SCALE);
     }
 
     #[test]

@@ -52,7 +52,7 @@ mod math;
 mod ray;
 pub mod sampling;
 
-pub use aabb::{Aabb, SLAB_FAR_SCALE};
+pub use aabb::{Aabb, SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG, widen_far};
 pub use camera::{Camera, CameraError, Projection};
 pub use colormap::{ColorMap, ColorMapError, ColorStop};
 #[cfg(feature = "alloc")]

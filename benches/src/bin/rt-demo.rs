@@ -9,6 +9,8 @@
 //! across each triangle, then mapped), sphere glyphs coloured with the
 //! cool-to-warm map, and a streamline tube of capsules, under a directional
 //! light with hard shadows. 8-bit sRGB RGBA.
+// A std-only tool crate: the no_std import lints guard the libraries.
+#![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
 use std::{path::PathBuf, process::ExitCode, time::Instant};
 

@@ -13,7 +13,7 @@ use glam::{Vec2, Vec3};
 
 use super::sphere::sphere_roots;
 use crate::{
-    Hit, PrimKind, Ray,
+    Aabb, Hit, PrimKind, Ray,
     math::{atan2, gamma, sqrt},
 };
 
@@ -46,6 +46,14 @@ impl Capsule {
         self.p0.is_finite() && self.p1.is_finite() && self.radius.is_finite() && self.radius > 0.0
     }
 
+    /// The bounding box: the union of the end spheres' boxes.
+    #[inline]
+    #[must_use]
+    pub fn bounds(&self) -> Aabb {
+        let r = Vec3::splat(self.radius);
+        Aabb::new(self.p0 - r, self.p0 + r).union(Aabb::new(self.p1 - r, self.p1 + r))
+    }
+
     /// Axial parameter `s ∈ [0, 1]` of the axis point closest to `p`.
     #[inline]
     #[must_use]
@@ -65,8 +73,13 @@ pub fn intersect_capsule_t(ray: &Ray, cap: &Capsule) -> Option<f32> {
     let d = ray.direction;
     let baba = ba.length_squared();
     let mut best: Option<f32> = None;
+    let bounds = cap.bounds();
     let mut keep = |t: f32| {
-        if t >= ray.t_min && t <= ray.t_max && best.is_none_or(|b| t < b) {
+        if t >= ray.t_min
+            && t <= ray.t_max
+            && best.is_none_or(|b| t < b)
+            && bounds.admits_hit(ray, t)
+        {
             best = Some(t);
         }
     };

@@ -10,7 +10,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::{
-    Hit, PrimKind, Ray,
+    Aabb, Hit, PrimKind, Ray,
     math::{acos, atan2, gamma, sqrt},
 };
 
@@ -30,6 +30,14 @@ impl Sphere {
     #[must_use]
     pub const fn new(center: Vec3, radius: f32) -> Self {
         Self { center, radius }
+    }
+
+    /// The bounding box `centre ± radius`.
+    #[inline]
+    #[must_use]
+    pub fn bounds(&self) -> Aabb {
+        let r = Vec3::splat(self.radius);
+        Aabb::new(self.center - r, self.center + r)
     }
 
     /// Whether centre and radius are finite and the radius positive.
@@ -65,7 +73,8 @@ pub fn solve_quadratic(a: f32, b: f32, c: f32, disc_over_a: f32) -> Option<(f32,
 #[must_use]
 pub fn intersect_sphere_t(ray: &Ray, sphere: &Sphere) -> Option<f32> {
     let (t0, t1) = sphere_roots(ray.origin - sphere.center, ray.direction, sphere.radius)?;
-    first_in_range(ray, t0, t1)
+    let b = sphere.bounds();
+    first_in_range(ray, t0, t1, |t| b.admits_hit(ray, t))
 }
 
 /// Ascending roots of `|f + t·d| = r` (`f` = origin − centre), stable form.
@@ -78,16 +87,16 @@ pub(crate) fn sphere_roots(f: Vec3, d: Vec3, r: f32) -> Option<(f32, f32)> {
     solve_quadratic(a, b, c, r * r - v.length_squared())
 }
 
-/// The closest root of two ascending roots inside the ray's interval.
+/// The closest of two ascending roots inside the ray's interval that the
+/// primitive's box admits ([`Aabb::admits_hit`]).
 #[inline]
-pub(crate) fn first_in_range(ray: &Ray, t0: f32, t1: f32) -> Option<f32> {
-    if t0 >= ray.t_min && t0 <= ray.t_max {
-        Some(t0)
-    } else if t1 >= ray.t_min && t1 <= ray.t_max {
-        Some(t1)
-    } else {
-        None
-    }
+pub(crate) fn first_in_range(
+    ray: &Ray,
+    t0: f32,
+    t1: f32,
+    admits: impl Fn(f32) -> bool,
+) -> Option<f32> {
+    [t0, t1].into_iter().find(|&t| t >= ray.t_min && t <= ray.t_max && admits(t))
 }
 
 /// Full hit record for a sphere: the hit point is re-projected onto the

@@ -10,7 +10,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::{Hit, PrimKind, Ray, math::gamma};
+use crate::{Aabb, Hit, PrimKind, Ray, math::gamma};
 
 /// Per-ray constants of the watertight test: the dominant axis `kz`, the
 /// two others `kx`, `ky` (swapped to keep winding), and the shear.
@@ -59,8 +59,9 @@ pub struct TriangleHit {
 }
 
 /// The watertight test with precomputed `pre`; `None` on a miss, for
-/// degenerate triangles (`det = 0`) and outside `[ray.t_min, ray.t_max]`.
-/// Both faces are hit (no culling).
+/// degenerate triangles (`det = 0`), outside `[ray.t_min, ray.t_max]`, and
+/// for hits outside the triangle's box by rounding
+/// ([`triangle_admits_hit`]). Both faces are hit (no culling).
 #[inline]
 #[must_use]
 pub fn intersect_triangle_t(
@@ -101,10 +102,19 @@ pub fn intersect_triangle_t(
     let tt = u * (s.z * a[kz]) + v * (s.z * b[kz]) + w * (s.z * c[kz]);
     let inv = 1.0 / det;
     let t = tt * inv;
-    if !(t >= ray.t_min && t <= ray.t_max) {
+    if !(t >= ray.t_min && t <= ray.t_max && triangle_admits_hit(ray, t, v0, v1, v2)) {
         return None;
     }
     Some(TriangleHit { t, b1: v * inv, b2: w * inv })
+}
+
+/// Whether a triangle hit at `t` lies inside the triangle's box as the
+/// robust slab test sees it ([`Aabb::admits_hit`]); rejects hits placed
+/// outside it by rounding (grazing rays, hits at `t ≈ t_min`).
+#[inline]
+#[must_use]
+pub fn triangle_admits_hit(ray: &Ray, t: f32, v0: Vec3, v1: Vec3, v2: Vec3) -> bool {
+    Aabb::new(v0.min(v1).min(v2), v0.max(v1).max(v2)).admits_hit(ray, t)
 }
 
 /// Whether the triangle has zero area: its edge cross product, evaluated in

@@ -5,6 +5,8 @@
 //! cargo run --release -p rt-benches --bin rt-report -- traversal [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- all [--quick]
 //! ```
+// A std-only tool crate: the no_std import lints guard the libraries.
+#![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
 mod timing;
 mod traversal;
