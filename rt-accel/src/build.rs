@@ -1,5 +1,5 @@
 //! Building with obvhs (feature `obvhs`): PLOC + reinsertion + leaf
-//! collapse into a binary BVH, then conversion to the 4-wide layout.
+//! collapse into a binary BVH, then conversion to the 8-wide layout.
 //!
 //! obvhs stays at this edge: inputs and outputs are rt types.
 
@@ -22,7 +22,7 @@ use rt_core::{
 use crate::{
     BuildError, Bvh, CapsuleItem, MAX_DEPTH, SphereItem, TriPacket,
     check::triangle_vertices,
-    node::{ChildRef, MAX_ITEMS, MAX_LEAF_ITEMS, Node},
+    node::{ChildRef, MAX_ITEMS, MAX_LEAF_ITEMS, Node, WIDTH},
     prim::Primitive,
 };
 
@@ -230,9 +230,9 @@ fn to_aabb(b: &obvhs::aabb::Aabb) -> Aabb {
     Aabb::new(b.min.into(), b.max.into())
 }
 
-/// Collapses a binary BVH into the 4-wide layout: each wide node takes its
+/// Collapses a binary BVH into the 8-wide layout: each wide node takes its
 /// binary node's two children and repeatedly opens the inner child of
-/// largest surface area until it has four. Nodes are emitted breadth
+/// largest surface area until it has [`WIDTH`]. Nodes are emitted breadth
 /// first (the order [`crate::validate`] checks), so children always follow
 /// their parent.
 fn convert<P: Primitive>(
@@ -262,7 +262,7 @@ fn convert<P: Primitive>(
         } else {
             alloc::vec![n.first_index as usize, n.first_index as usize + 1]
         };
-        while kids.len() < 4 {
+        while kids.len() < WIDTH {
             let open = kids
                 .iter()
                 .enumerate()

@@ -7,7 +7,7 @@ use rt_core::{Aabb, Hit, Ray, SceneQuery};
 use crate::{
     BuildError, LoadError,
     bytes::{Header, parse, validate},
-    node::{ChildRef, Node},
+    node::{ChildRef, Node, WIDTH},
     prim::{BestHit, Primitive},
     traverse::BvhRef,
 };
@@ -140,7 +140,7 @@ impl<P: Primitive> Bvh<P> {
         update(&mut self.items)?;
         // Children come after parents, so a reverse sweep sees children first.
         for i in (0..self.nodes.len()).rev() {
-            for slot in 0..4 {
+            for slot in 0..WIDTH {
                 let c = self.nodes[i].children[slot];
                 let b = if c.is_empty() {
                     Aabb::EMPTY

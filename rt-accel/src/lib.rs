@@ -1,10 +1,10 @@
 //! # rt-accel
 //!
-//! A 4-wide bounding volume hierarchy for the `rt` crates. Trees are built
+//! An 8-wide bounding volume hierarchy for the `rt` crates. Trees are built
 //! with [obvhs](https://crates.io/crates/obvhs)'s PLOC builder (feature
 //! `obvhs`), then converted to a layout of our own: plain `bytemuck::Pod`
-//! nodes holding four child boxes in structure-of-arrays form, tested in
-//! one SSE pass, and leaves of triangle packets tested four at a time with
+//! nodes holding eight child boxes in structure-of-arrays form, tested four
+//! per SSE pass, and leaves of triangle packets tested four at a time with
 //! the watertight algorithm. The layout can be written to bytes, loaded
 //! elsewhere (checked: malformed bytes are an `Err`) and traversed with no
 //! std and no allocation.
@@ -73,10 +73,10 @@ pub use bytes::{Header, MAGIC, VERSION, validate};
 pub use error::{BuildError, LoadError};
 #[cfg(feature = "alloc")]
 pub use mesh::TriangleMesh;
-pub use node::{ChildRef, MAX_ITEMS, MAX_LEAF_ITEMS, Node};
+pub use node::{ChildRef, GROUPS, MAX_ITEMS, MAX_LEAF_ITEMS, Node, WIDTH};
 pub use prim::{BestHit, CapsuleItem, Primitive, SphereItem};
 pub use ray_ctx::RayCtx;
 #[cfg(feature = "alloc")]
 pub use scene::Scene;
-pub use traverse::{BvhRef, MAX_DEPTH, STACK_SIZE, TraversalStats};
+pub use traverse::{BvhRef, MAX_DEPTH, STACK_SIZE, TraversalStack, TraversalStats};
 pub use tri_packet::TriPacket;

@@ -12,8 +12,8 @@ use std::sync::LazyLock;
 use proptest::prelude::*;
 use rt_accel::{
     BuildParams, Bvh, BvhRef, CapsuleItem, ChildRef, Header, LoadError, MAGIC, MAX_DEPTH,
-    MAX_ITEMS, Node, Primitive, SphereItem, TraversalStats, TriPacket, VERSION, build_capsules,
-    build_spheres, build_triangles,
+    MAX_ITEMS, Node, Primitive, SphereItem, TraversalStats, TriPacket, VERSION, WIDTH,
+    build_capsules, build_spheres, build_triangles,
 };
 use rt_core::{
     Ray,
@@ -507,7 +507,7 @@ fn nodes_reached_twice_are_not_a_tree() {
     let bytes = tri_bvh().to_bytes();
     let nodes = nodes_of(&bytes);
     let (i, a, b) = (0..nodes.len())
-        .flat_map(|i| (0..4).flat_map(move |a| (0..4).map(move |b| (i, a, b))))
+        .flat_map(|i| (0..WIDTH).flat_map(move |a| (0..WIDTH).map(move |b| (i, a, b))))
         .find(|&(i, a, b)| {
             let (ca, cb) = (nodes[i].children[a], nodes[i].children[b]);
             a != b
@@ -520,14 +520,14 @@ fn nodes_reached_twice_are_not_a_tree() {
     assert_eq!(load::<TriPacket>(&bad).err(), Some(LoadError::NotATree));
 }
 
-/// A chain of `depth` nodes whose child boxes all hold `[-10, 10]³`: slots
-/// 0–2 are leaves of the one item, slot 3 the next node (the last node has
-/// four leaves). The worst case for the fixed traversal stacks: every level
-/// pushes three siblings.
+/// A chain of `depth` nodes whose child boxes all hold `[-10, 10]³`: all
+/// slots but the last are leaves of the one item, the last slot the next
+/// node (the last node has only leaves). The worst case for the fixed
+/// traversal stacks: every level pushes `WIDTH − 1` siblings.
 fn chain(depth: usize) -> Vec<u8> {
-    // The node layout is the crate's own: take a real node whose four child
+    // The node layout is the crate's own: take a real node whose child
     // boxes all hold the cube, and rewire its children.
-    let s = [Sphere::new(Vec3::ZERO, 10.0); 4];
+    let s = [Sphere::new(Vec3::ZERO, 10.0); WIDTH];
     let one_per_leaf = BuildParams { max_leaf_size: 1, ..params() };
     let boxes = build_spheres(&s, &one_per_leaf).unwrap();
     let template = boxes.as_ref().nodes()[0];
@@ -537,12 +537,10 @@ fn chain(depth: usize) -> Vec<u8> {
         .map(|i| {
             let mut n = template;
             let leaf = ChildRef::leaf(0, 1);
-            n.children = [
-                leaf,
-                leaf,
-                leaf,
-                if i + 1 < depth { ChildRef::inner(i as u32 + 1) } else { leaf },
-            ];
+            n.children = [leaf; WIDTH];
+            if i + 1 < depth {
+                n.children[WIDTH - 1] = ChildRef::inner(i as u32 + 1);
+            }
             n
         })
         .collect();
@@ -556,7 +554,7 @@ fn chain(depth: usize) -> Vec<u8> {
     assemble(h, &nodes, &[packet])
 }
 
-/// The deepest tree the loaders accept ([`MAX_DEPTH`] levels, three
+/// The deepest tree the loaders accept ([`MAX_DEPTH`] levels, `WIDTH − 1`
 /// siblings pushed per level) is traversed within the fixed stacks: a ray
 /// that enters every box but misses the triangle visits every node and
 /// every leaf (no overflow, nothing skipped), a ray through the triangle
@@ -570,7 +568,7 @@ fn deepest_accepted_tree_fits_the_traversal_stacks() {
     let mut stats = TraversalStats::default();
     assert_eq!(bvh.as_ref().closest_hit_stats(&miss, &mut stats), None);
     assert_eq!(stats.nodes as usize, MAX_DEPTH);
-    assert_eq!(stats.items as usize, 3 * (MAX_DEPTH - 1) + 4);
+    assert_eq!(stats.items as usize, (WIDTH - 1) * (MAX_DEPTH - 1) + WIDTH);
     assert!(!bvh.occluded(&miss));
     assert_eq!(bvh.closest_t(&hit).map(|b| (b.t, b.prim)), Some((5.0, 0)));
     assert!(bvh.occluded(&hit));

@@ -11,7 +11,7 @@ use obvhs::{
     ray::{Ray as ORay, RayHit},
     triangle::Triangle,
 };
-use rt_accel::{BuildParams, BuildQuality, build_triangles};
+use rt_accel::{BuildParams, BuildQuality, TraversalStack, build_triangles};
 use rt_benches::scenes::{self, Mesh};
 use rt_core::Ray;
 
@@ -84,8 +84,9 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
                 "rt",
                 Box::new(|rays: &[Ray]| {
                     let (mut n, mut sum) = (0, 0.0);
+                    let mut stack = TraversalStack::new();
                     for r in rays {
-                        if let Some(h) = bvh.closest_t(black_box(r)) {
+                        if let Some(h) = bvh.as_ref().closest_t_with(black_box(r), &mut stack) {
                             n += 1;
                             sum += f64::from(h.t);
                         }
