@@ -8,6 +8,8 @@
 // A std-only tool crate: the no_std import lints guard the libraries.
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
+#[cfg(feature = "embree3")]
+mod embree3;
 mod timing;
 mod traversal;
 

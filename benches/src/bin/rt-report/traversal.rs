@@ -80,7 +80,10 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
             b2.primitive_indices.iter().map(|&i| tris[i as usize]).collect();
 
         let to_o = |r: &Ray| ORay::new(r.origin.into(), r.direction.into(), r.t_min, r.t_max);
-        let tracers: Vec<(&str, Tracer<'_>)> = vec![
+        #[cfg(feature = "embree3")]
+        let embree = crate::embree3::EmbreeScene::new(&s.mesh.positions, &s.mesh.indices);
+        #[allow(unused_mut, reason = "optional implementations are pushed below")]
+        let mut tracers: Vec<(&str, Tracer<'_>)> = vec![
             (
                 "rt",
                 Box::new(|rays: &[Ray]| {
@@ -128,6 +131,21 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
                 }),
             ),
         ];
+        #[cfg(feature = "embree3")]
+        tracers.push((
+            "embree3",
+            Box::new(|rays: &[Ray]| {
+                let (mut n, mut sum) = (0, 0.0);
+                let mut ctx = crate::embree3::context();
+                for r in rays {
+                    if let Some((t, _)) = embree.closest(&mut ctx, black_box(r)) {
+                        n += 1;
+                        sum += f64::from(t);
+                    }
+                }
+                (n, sum)
+            }),
+        ));
         let (lo, hi) = s.mesh.bounds();
         let ray_sets = [
             ("primary", scenes::primary_rays(s.eye, s.target, res, res)),

@@ -1,0 +1,60 @@
+//! Embree 3 (feature `embree3`) as one more implementation in the
+//! traversal table: its own BVH (default build quality) and single-ray
+//! `rtcIntersect1`, same triangles, same rays.
+
+use cgmath::{Vector3, Vector4};
+use embree::{
+    CommittedScene, Device, Geometry, IntersectContext, Ray, RayHit, Scene, TriangleMesh,
+};
+use glam::Vec3;
+
+/// A committed Embree scene. The device and scene are leaked: the report
+/// builds two scenes and exits, and Embree's API ties the committed scene's
+/// lifetime to both.
+pub(crate) struct EmbreeScene {
+    scene: CommittedScene<'static>,
+}
+
+impl EmbreeScene {
+    pub(crate) fn new(positions: &[Vec3], indices: &[[u32; 3]]) -> Self {
+        let device: &'static Device = Box::leak(Box::new(Device::new()));
+        let mut mesh = TriangleMesh::unanimated(device, indices.len(), positions.len());
+        {
+            let mut v = mesh.vertex_buffer.map();
+            for (i, p) in positions.iter().enumerate() {
+                v[i] = Vector4::new(p.x, p.y, p.z, 0.0);
+            }
+            let mut ib = mesh.index_buffer.map();
+            for (i, t) in indices.iter().enumerate() {
+                ib[i] = Vector3::new(t[0], t[1], t[2]);
+            }
+        }
+        let mut geom = Geometry::Triangle(mesh);
+        geom.commit();
+        let scene: &'static mut Scene<'static> = Box::leak(Box::new(Scene::new(device)));
+        scene.attach_geometry(geom);
+        Self { scene: scene.commit() }
+    }
+
+    /// `(t, primitive)` of the closest hit.
+    pub(crate) fn closest(
+        &self,
+        ctx: &mut IntersectContext,
+        r: &rt_core::Ray,
+    ) -> Option<(f32, u32)> {
+        let (o, d) = (r.origin, r.direction);
+        let mut rh = RayHit::new(Ray::segment(
+            Vector3::new(o.x, o.y, o.z),
+            Vector3::new(d.x, d.y, d.z),
+            r.t_min,
+            r.t_max,
+        ));
+        self.scene.intersect(ctx, &mut rh);
+        rh.hit.hit().then_some((rh.ray.tfar, rh.hit.primID))
+    }
+}
+
+/// A context for single incoherent rays.
+pub(crate) fn context() -> IntersectContext {
+    IntersectContext::incoherent()
+}
