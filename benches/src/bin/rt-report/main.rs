@@ -11,6 +11,8 @@
 #[cfg(feature = "embree3")]
 mod embree3;
 mod timing;
+#[cfg(feature = "tinybvh")]
+mod tinybvh;
 mod traversal;
 
 use std::{path::PathBuf, process::ExitCode};

@@ -29,6 +29,19 @@ struct Scene {
 /// One implementation under test: traces all rays, returns (hits, Σt).
 type Tracer<'a> = Box<dyn Fn(&[Ray]) -> (u64, f64) + 'a>;
 
+/// Traces every ray with `f`, returning (hits, Σt).
+#[allow(dead_code, reason = "used by the optional implementations")]
+fn count(rays: &[Ray], mut f: impl FnMut(&Ray) -> Option<(f32, u32)>) -> (u64, f64) {
+    let (mut n, mut sum) = (0, 0.0);
+    for r in rays {
+        if let Some((t, _)) = f(black_box(r)) {
+            n += 1;
+            sum += f64::from(t);
+        }
+    }
+    (n, sum)
+}
+
 pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
     let (terrain_n, ico_level, res, incoherent) =
         if quick { (256, 6, 256, 1 << 16) } else { (725, 8, 1024, 1 << 20) };
@@ -82,6 +95,8 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
         let to_o = |r: &Ray| ORay::new(r.origin.into(), r.direction.into(), r.t_min, r.t_max);
         #[cfg(feature = "embree3")]
         let embree = crate::embree3::EmbreeScene::new(&s.mesh.positions, &s.mesh.indices);
+        #[cfg(feature = "tinybvh")]
+        let tiny = crate::tinybvh::TinyScene::new(&s.mesh.positions, &s.mesh.indices)?;
         #[allow(unused_mut, reason = "optional implementations are pushed below")]
         let mut tracers: Vec<(&str, Tracer<'_>)> = vec![
             (
@@ -135,17 +150,15 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
         tracers.push((
             "embree3",
             Box::new(|rays: &[Ray]| {
-                let (mut n, mut sum) = (0, 0.0);
                 let mut ctx = crate::embree3::context();
-                for r in rays {
-                    if let Some((t, _)) = embree.closest(&mut ctx, black_box(r)) {
-                        n += 1;
-                        sum += f64::from(t);
-                    }
-                }
-                (n, sum)
+                count(rays, |r| embree.closest(&mut ctx, r))
             }),
         ));
+        #[cfg(feature = "tinybvh")]
+        tracers.push(("tinybvh", Box::new(|rays: &[Ray]| count(rays, |r| tiny.closest(r)))));
+        #[cfg(all(feature = "tinybvh", target_feature = "avx2"))]
+        tracers
+            .push(("tinybvh-bvh8cpu", Box::new(|rays: &[Ray]| count(rays, |r| tiny.closest8(r)))));
         let (lo, hi) = s.mesh.bounds();
         let ray_sets = [
             ("primary", scenes::primary_rays(s.eye, s.target, res, res)),
