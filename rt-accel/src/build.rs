@@ -164,6 +164,17 @@ pub fn build_triangles(
     Ok(Bvh { nodes, items, prim_count })
 }
 
+impl crate::TriangleMesh {
+    /// Builds a BVH over the mesh ([`build_triangles`]); hits carry the
+    /// triangle index and barycentrics for [`crate::TriangleMesh::interpolate_scalar`].
+    ///
+    /// # Errors
+    /// As [`build_triangles`] (a validated mesh only fails on size limits).
+    pub fn build_bvh(&self, params: &BuildParams) -> Result<Bvh<TriPacket>, BuildError> {
+        build_triangles(self.positions(), self.indices(), params)
+    }
+}
+
 /// Builds a BVH over spheres.
 ///
 /// # Errors

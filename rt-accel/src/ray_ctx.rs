@@ -11,15 +11,22 @@ use crate::simd::F32x4;
 pub struct RayCtx {
     pub(crate) ray: Ray,
     /// Origin per axis, splatted.
+    #[cfg_attr(all(target_arch = "x86_64", target_feature = "avx"), allow(dead_code))]
     pub(crate) org: [F32x4; 3],
-    /// Reciprocal direction per axis (`±∞` for `±0`), splatted.
+    /// Reciprocal direction per axis (`±∞` for `±0`).
+    #[cfg_attr(not(all(target_arch = "x86_64", target_feature = "avx")), allow(dead_code))]
+    pub(crate) inv1: glam::Vec3,
+    /// Reciprocal direction per axis, splatted.
+    #[cfg_attr(all(target_arch = "x86_64", target_feature = "avx"), allow(dead_code))]
     pub(crate) inv: [F32x4; 3],
     /// Row of `Node::bounds` holding the near plane per axis (by sign bit).
     pub(crate) near: [usize; 3],
     /// Row holding the far plane per axis.
     pub(crate) far: [usize; 3],
     /// `1 ± 2γ(3)`: far distances are widened outward by rounding bounds.
+    #[cfg_attr(all(target_arch = "x86_64", target_feature = "avx"), allow(dead_code))]
     pub(crate) far_up: F32x4,
+    #[cfg_attr(all(target_arch = "x86_64", target_feature = "avx"), allow(dead_code))]
     pub(crate) far_down: F32x4,
     pub(crate) t_min: F32x4,
     /// Watertight shear constants for triangles.
@@ -53,6 +60,7 @@ impl RayCtx {
         let [kx, ky, kz] = wt.axes;
         Some(Self {
             ray: *ray,
+            inv1: inv,
             org: [F32x4::splat(o.x), F32x4::splat(o.y), F32x4::splat(o.z)],
             inv: [F32x4::splat(inv.x), F32x4::splat(inv.y), F32x4::splat(inv.z)],
             near: [nx, ny, nz],

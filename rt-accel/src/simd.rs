@@ -51,12 +51,14 @@ mod imp {
         }
         /// `self` if `self > o`, else `o` (so NaN in either gives `o`).
         #[inline(always)]
+        #[cfg_attr(target_feature = "avx", allow(dead_code, reason = "AVX node tests"))]
         pub(crate) fn max(self, o: Self) -> Self {
             // SAFETY: SSE is in the x86-64 baseline.
             Self(unsafe { _mm_max_ps(self.0, o.0) })
         }
         /// `self` if `self < o`, else `o` (so NaN in either gives `o`).
         #[inline(always)]
+        #[cfg_attr(target_feature = "avx", allow(dead_code, reason = "AVX node tests"))]
         pub(crate) fn min(self, o: Self) -> Self {
             // SAFETY: SSE is in the x86-64 baseline.
             Self(unsafe { _mm_min_ps(self.0, o.0) })
@@ -150,6 +152,61 @@ mod imp {
 }
 
 pub(crate) use imp::F32x4;
+
+/// Eight f32 lanes on AVX, compiled only when the build enables AVX
+/// (`-C target-cpu=native` or `-C target-feature=+avx`): node tests then take
+/// one pass for all eight children. Same NaN rule as [`F32x4`].
+#[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+mod avx {
+    use core::arch::x86_64::*;
+
+    #[derive(Clone, Copy, Debug)]
+    #[repr(transparent)]
+    pub(crate) struct F32x8(__m256);
+
+    // SAFETY (every block below): AVX is enabled for this whole build, the
+    // module is compiled only then.
+    impl F32x8 {
+        #[inline(always)]
+        pub(crate) fn splat(x: f32) -> Self {
+            Self(unsafe { _mm256_set1_ps(x) })
+        }
+        #[inline(always)]
+        pub(crate) fn from_groups(g: [[f32; 4]; 2]) -> Self {
+            Self(bytemuck::cast(g))
+        }
+        #[inline(always)]
+        pub(crate) fn to_array(self) -> [f32; 8] {
+            bytemuck::cast(self.0)
+        }
+        #[inline(always)]
+        pub(crate) fn sub(self, o: Self) -> Self {
+            Self(unsafe { _mm256_sub_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        pub(crate) fn mul(self, o: Self) -> Self {
+            Self(unsafe { _mm256_mul_ps(self.0, o.0) })
+        }
+        /// `self` if `self > o`, else `o` (NaN in either gives `o`).
+        #[inline(always)]
+        pub(crate) fn max(self, o: Self) -> Self {
+            Self(unsafe { _mm256_max_ps(self.0, o.0) })
+        }
+        /// `self` if `self < o`, else `o` (NaN in either gives `o`).
+        #[inline(always)]
+        pub(crate) fn min(self, o: Self) -> Self {
+            Self(unsafe { _mm256_min_ps(self.0, o.0) })
+        }
+        /// Bit `i` set where lane `i` has `self <= o` (false for NaN).
+        #[inline(always)]
+        pub(crate) fn le_mask(self, o: Self) -> u32 {
+            (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) }) as u32
+        }
+    }
+}
+
+#[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+pub(crate) use avx::F32x8;
 
 /// Hints the CPU to start loading the first two cache lines of `r`.
 #[inline(always)]

@@ -7,7 +7,7 @@ use crate::{
     RayCtx,
     node::{ChildRef, GROUPS, Node, WIDTH},
     prim::{BestHit, Primitive},
-    simd::{F32x4, prefetch},
+    simd::prefetch,
 };
 
 /// Deepest tree accepted by builders and loaders (root = depth 1).
@@ -144,7 +144,6 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             return false;
         }
         let t_max = ray.t_max;
-        let tmax4 = F32x4::splat(t_max);
         let stack = &mut stack.refs;
         let mut sp = 0;
         let mut cur = ChildRef::inner(0);
@@ -158,7 +157,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 }
             } else {
                 let node = &self.nodes[cur.index()];
-                let (mask, _) = box_test(node, &ctx, tmax4);
+                let (mask, _) = box_test(node, &ctx, t_max);
                 let mut m = mask;
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
@@ -219,7 +218,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 // may still hold an exact tie; widen the bound as the far
                 // planes are widened.
                 let bound = widen_far(best.t);
-                let (mut mask, tnear) = box_test(node, ctx, F32x4::splat(bound));
+                let (mut mask, tnear) = box_test(node, ctx, bound);
                 // Gather the hit, non-empty children with their entry distances.
                 let mut refs = [ChildRef::EMPTY; WIDTH];
                 let mut ts = [0.0f32; WIDTH];
@@ -283,9 +282,12 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
 /// Tests the ray against a node's boxes (Ize 2013's robust slab test, see
 /// [`rt_core::Aabb::intersect_ray`]), four per SSE pass. Returns the mask of
 /// boxes entered within `[t_min, t_max]` and the entry distances.
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
 #[inline(always)]
-fn box_test(node: &Node, ctx: &RayCtx, t_max: F32x4) -> (u32, [f32; WIDTH]) {
+fn box_test(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
+    use crate::simd::F32x4;
     let b = &node.bounds;
+    let t_max = F32x4::splat(t_max);
     let mut mask = 0;
     let mut tnear = [0.0f32; WIDTH];
     for g in 0..GROUPS {
@@ -307,6 +309,32 @@ fn box_test(node: &Node, ctx: &RayCtx, t_max: F32x4) -> (u32, [f32; WIDTH]) {
         tnear[4 * g..4 * g + 4].copy_from_slice(&t0.to_array());
     }
     (mask, tnear)
+}
+
+/// [`box_test`] in one AVX pass over all eight children (builds with AVX
+/// enabled). Identical arithmetic, lane for lane.
+#[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+#[inline(always)]
+fn box_test(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
+    use crate::simd::F32x8;
+    const { assert!(GROUPS == 2) };
+    let b = &node.bounds;
+    let slab = |a: usize| {
+        let (o, inv) = (F32x8::splat(ctx.ray.origin[a]), F32x8::splat(ctx.inv1[a]));
+        let near = F32x8::from_groups(b[ctx.near[a]]).sub(o).mul(inv);
+        let far = F32x8::from_groups(b[ctx.far[a]]).sub(o).mul(inv);
+        (near, far)
+    };
+    let (nx, fx) = slab(0);
+    let (ny, fy) = slab(1);
+    let (nz, fz) = slab(2);
+    let t0 = nx.max(ny.max(nz.max(F32x8::splat(ctx.ray.t_min))));
+    let t1 = fx.min(fy.min(fz.min(F32x8::splat(f32::INFINITY))));
+    let t1 = t1
+        .mul(F32x8::splat(rt_core::SLAB_FAR_SCALE))
+        .max(t1.mul(F32x8::splat(rt_core::SLAB_FAR_SCALE_NEG)))
+        .min(F32x8::splat(t_max));
+    (t0.le_mask(t1), t0.to_array())
 }
 
 impl<P: Primitive> SceneQuery for BvhRef<'_, P> {

@@ -172,3 +172,27 @@ fn bad_input_is_an_error_naming_it() {
     );
     assert_eq!(bvh, before, "a failed refit changes nothing");
 }
+
+/// A scalar that is linear in space, sampled at the vertices, interpolates
+/// at every hit to its exact value at the hit point (barycentrics are right
+/// and belong to the reported triangle).
+#[test]
+fn mesh_scalars_interpolate_at_hits() {
+    use rt_accel::TriangleMesh;
+    let (pos, idx) = icosphere(2);
+    let f = |p: Vec3| 2.0 * p.x - 0.5 * p.y + 3.0 * p.z + 1.0;
+    let scalars = pos.iter().map(|p| f(*p)).collect();
+    let mesh = TriangleMesh::new(pos.clone(), idx, Some(scalars)).unwrap();
+    let bvh = mesh.build_bvh(&params()).unwrap();
+    let mut hits = 0;
+    for i in 0..200 {
+        let a = i as f32 * 0.618;
+        let o = Vec3::new(3.0 * a.cos(), 1.3 * (0.7 * a).sin(), 3.0 * a.sin());
+        let h = bvh.closest_hit(&Ray::new(o, -o + Vec3::new(0.1, -0.2, 0.05))).expect("hit");
+        let s = mesh.interpolate_scalar(&h).unwrap();
+        assert!((s - f(h.position)).abs() < 1e-4, "{s} vs {}", f(h.position));
+        hits += 1;
+    }
+    assert_eq!(hits, 200);
+    assert!(TriangleMesh::new(pos, vec![[0, 1, 2]], Some(vec![0.0])).is_err());
+}

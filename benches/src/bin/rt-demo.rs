@@ -15,7 +15,7 @@
 use std::{path::PathBuf, process::ExitCode, time::Instant};
 
 use glam::Vec3;
-use rt_accel::{BuildParams, Scene, TriangleMesh, build_capsules, build_spheres, build_triangles};
+use rt_accel::{BuildParams, Scene, TriangleMesh, build_capsules, build_spheres};
 use rt_benches::{image::write_png, scenes};
 use rt_core::{
     Camera, ColorMap, Frame, Hit, PrimKind, Projection, Ray, SceneQuery,
@@ -43,8 +43,7 @@ fn build_world() -> Result<World, String> {
     let mesh = TriangleMesh::new(terrain.positions, terrain.indices, Some(heights))
         .map_err(|e| e.to_string())?;
     let params = BuildParams::medium();
-    let triangles =
-        build_triangles(mesh.positions(), mesh.indices(), &params).map_err(|e| e.to_string())?;
+    let triangles = mesh.build_bvh(&params).map_err(|e| e.to_string())?;
     // A ring of glyphs above the terrain, sized and coloured by a scalar.
     let spheres: Vec<Sphere> = (0..24)
         .map(|i| {
