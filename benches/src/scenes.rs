@@ -1,7 +1,5 @@
 //! Deterministic scenes and ray sets.
 
-use std::collections::HashMap;
-
 use glam::Vec3;
 use rt_core::{Camera, Projection, Ray, glam::Vec2, sampling};
 
@@ -73,63 +71,8 @@ pub fn terrain(n: u32) -> Mesh {
 /// The unit icosphere subdivided `level` times (`20 · 4^level` triangles).
 #[must_use]
 pub fn icosphere(level: u32) -> Mesh {
-    let t = (1.0 + 5.0f32.sqrt()) / 2.0;
-    let base = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ];
-    let mut positions: Vec<Vec3> =
-        base.iter().map(|&(x, y, z)| Vec3::new(x, y, z).normalize()).collect();
-    let mut indices: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut next = Vec::with_capacity(indices.len() * 4);
-        let mut midpoint = |a: u32, b: u32, pos: &mut Vec<Vec3>| {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                pos.push(((pos[a as usize] + pos[b as usize]) * 0.5).normalize());
-                pos.len() as u32 - 1
-            })
-        };
-        for [a, b, c] in indices {
-            let ab = midpoint(a, b, &mut positions);
-            let bc = midpoint(b, c, &mut positions);
-            let ca = midpoint(c, a, &mut positions);
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        indices = next;
-    }
-    Mesh { positions, indices }
+    let m = rt_accel::TriangleMesh::icosphere(level);
+    Mesh { positions: m.positions().to_vec(), indices: m.indices().to_vec() }
 }
 
 /// `width × height` primary rays (pixel centres) of a perspective camera

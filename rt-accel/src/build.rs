@@ -23,7 +23,7 @@ use crate::{
     BuildError, Bvh, CapsuleItem, MAX_DEPTH, SphereItem, TriPacket,
     check::triangle_vertices,
     node::{ChildRef, MAX_ITEMS, MAX_LEAF_ITEMS, Node, WIDTH},
-    prim::Primitive,
+    prim::{Primitive, ShapeItem},
 };
 
 /// obvhs's build presets, from fastest build to best traversal.
@@ -184,15 +184,7 @@ pub fn build_spheres(
     spheres: &[Sphere],
     params: &BuildParams,
 ) -> Result<Bvh<SphereItem>, BuildError> {
-    if let Some(index) = spheres.iter().position(|s| !s.is_valid()) {
-        return Err(BuildError::InvalidPrimitive { index });
-    }
-    let items: Vec<SphereItem> = spheres
-        .iter()
-        .enumerate()
-        .map(|(i, &sphere)| SphereItem { sphere, prim: i as u32, pad: [0; 3] })
-        .collect();
-    build_items(items, params)
+    build_shapes(spheres, params)
 }
 
 /// Builds a BVH over capsules (tubes with round caps).
@@ -204,14 +196,17 @@ pub fn build_capsules(
     capsules: &[Capsule],
     params: &BuildParams,
 ) -> Result<Bvh<CapsuleItem>, BuildError> {
-    if let Some(index) = capsules.iter().position(|c| !c.is_valid()) {
+    build_shapes(capsules, params)
+}
+
+fn build_shapes<P: ShapeItem>(
+    shapes: &[P::Shape],
+    params: &BuildParams,
+) -> Result<Bvh<P>, BuildError> {
+    if let Some(index) = shapes.iter().position(|s| !P::shape_is_valid(s)) {
         return Err(BuildError::InvalidPrimitive { index });
     }
-    let items: Vec<CapsuleItem> = capsules
-        .iter()
-        .enumerate()
-        .map(|(i, &capsule)| CapsuleItem { capsule, prim: i as u32, pad: [0; 3] })
-        .collect();
+    let items = shapes.iter().enumerate().map(|(i, &s)| P::wrap(s, i as u32)).collect();
     build_items(items, params)
 }
 

@@ -1,6 +1,6 @@
 //! Triangle meshes with optional per-vertex scalars.
 
-use alloc::vec::Vec;
+use alloc::{collections::BTreeMap, vec::Vec};
 
 use glam::Vec3;
 use rt_core::{Hit, PrimKind};
@@ -46,6 +46,75 @@ impl TriangleMesh {
             });
         }
         Ok(Self { positions, indices, scalars })
+    }
+
+    /// The unit sphere as an icosahedron subdivided `level` times
+    /// (`20 · 4^level` triangles, shared vertices, counter-clockwise seen
+    /// from outside): a closed mesh for glyphs and tests.
+    ///
+    /// # Panics
+    /// If `level > 10` (over 20M triangles; a programming error).
+    #[must_use]
+    pub fn icosphere(level: u32) -> Self {
+        assert!(level <= 10, "icosphere level {level} is too fine");
+        let t = (1.0 + 5.0f32.sqrt()) / 2.0;
+        let base = [
+            (-1.0, t, 0.0),
+            (1.0, t, 0.0),
+            (-1.0, -t, 0.0),
+            (1.0, -t, 0.0),
+            (0.0, -1.0, t),
+            (0.0, 1.0, t),
+            (0.0, -1.0, -t),
+            (0.0, 1.0, -t),
+            (t, 0.0, -1.0),
+            (t, 0.0, 1.0),
+            (-t, 0.0, -1.0),
+            (-t, 0.0, 1.0),
+        ];
+        let mut positions: Vec<Vec3> =
+            base.iter().map(|&(x, y, z)| Vec3::new(x, y, z).normalize()).collect();
+        let mut indices: Vec<[u32; 3]> = alloc::vec![
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ];
+        for _ in 0..level {
+            // Each edge's midpoint is made once and shared by both triangles.
+            let mut mid = BTreeMap::new();
+            let mut midpoint = |a: u32, b: u32, pos: &mut Vec<Vec3>| {
+                *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    pos.push(((pos[a as usize] + pos[b as usize]) * 0.5).normalize());
+                    pos.len() as u32 - 1
+                })
+            };
+            let mut next = Vec::with_capacity(indices.len() * 4);
+            for [a, b, c] in indices {
+                let ab = midpoint(a, b, &mut positions);
+                let bc = midpoint(b, c, &mut positions);
+                let ca = midpoint(c, a, &mut positions);
+                next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+            }
+            indices = next;
+        }
+        Self { positions, indices, scalars: None }
     }
 
     /// Vertex positions.

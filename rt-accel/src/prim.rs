@@ -168,3 +168,50 @@ impl Primitive for CapsuleItem {
         self.capsule.is_valid() && self.prim < prim_count
     }
 }
+
+/// Items that wrap one shape (sphere, capsule) with its primitive index:
+/// lets building and refitting share one code path.
+pub(crate) trait ShapeItem: Primitive {
+    /// The wrapped shape.
+    type Shape: Copy;
+    /// The item for shape `prim`.
+    fn wrap(shape: Self::Shape, prim: u32) -> Self;
+    /// Replaces the shape (refit).
+    fn set_shape(&mut self, shape: Self::Shape);
+    /// The primitive index.
+    fn prim(&self) -> u32;
+    /// Whether the shape is finite with a positive radius.
+    fn shape_is_valid(shape: &Self::Shape) -> bool;
+}
+
+impl ShapeItem for SphereItem {
+    type Shape = Sphere;
+    fn wrap(sphere: Sphere, prim: u32) -> Self {
+        Self { sphere, prim, pad: [0; 3] }
+    }
+    fn set_shape(&mut self, shape: Sphere) {
+        self.sphere = shape;
+    }
+    fn prim(&self) -> u32 {
+        self.prim
+    }
+    fn shape_is_valid(shape: &Sphere) -> bool {
+        shape.is_valid()
+    }
+}
+
+impl ShapeItem for CapsuleItem {
+    type Shape = Capsule;
+    fn wrap(capsule: Capsule, prim: u32) -> Self {
+        Self { capsule, prim, pad: [0; 3] }
+    }
+    fn set_shape(&mut self, shape: Capsule) {
+        self.capsule = shape;
+    }
+    fn prim(&self) -> u32 {
+        self.prim
+    }
+    fn shape_is_valid(shape: &Capsule) -> bool {
+        shape.is_valid()
+    }
+}

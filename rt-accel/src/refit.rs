@@ -3,7 +3,9 @@
 use glam::Vec3;
 use rt_core::intersect::{Capsule, Sphere, is_degenerate_triangle};
 
-use crate::{BuildError, Bvh, CapsuleItem, SphereItem, TriPacket, check::triangle_vertices};
+use crate::{
+    BuildError, Bvh, CapsuleItem, SphereItem, TriPacket, check::triangle_vertices, prim::ShapeItem,
+};
 
 impl Bvh<TriPacket> {
     /// Moves every triangle to its new vertices (`indices` must be the list
@@ -51,18 +53,7 @@ impl Bvh<SphereItem> {
     /// [`BuildError::RefitMismatch`] for a different count,
     /// [`BuildError::InvalidPrimitive`] for a bad sphere; nothing changes.
     pub fn refit_spheres(&mut self, spheres: &[Sphere]) -> Result<(), BuildError> {
-        if spheres.len() != self.prim_count as usize {
-            return Err(BuildError::RefitMismatch);
-        }
-        if let Some(index) = spheres.iter().position(|s| !s.is_valid()) {
-            return Err(BuildError::InvalidPrimitive { index });
-        }
-        self.refit_with(|items| {
-            for it in items {
-                it.sphere = spheres[it.prim as usize];
-            }
-            Ok(())
-        })
+        refit_shapes(self, spheres)
     }
 }
 
@@ -73,17 +64,22 @@ impl Bvh<CapsuleItem> {
     /// [`BuildError::RefitMismatch`] for a different count,
     /// [`BuildError::InvalidPrimitive`] for a bad capsule; nothing changes.
     pub fn refit_capsules(&mut self, capsules: &[Capsule]) -> Result<(), BuildError> {
-        if capsules.len() != self.prim_count as usize {
-            return Err(BuildError::RefitMismatch);
-        }
-        if let Some(index) = capsules.iter().position(|c| !c.is_valid()) {
-            return Err(BuildError::InvalidPrimitive { index });
-        }
-        self.refit_with(|items| {
-            for it in items {
-                it.capsule = capsules[it.prim as usize];
-            }
-            Ok(())
-        })
+        refit_shapes(self, capsules)
     }
+}
+
+/// Checks the new shapes, then moves every item and refits the boxes.
+fn refit_shapes<P: ShapeItem>(bvh: &mut Bvh<P>, shapes: &[P::Shape]) -> Result<(), BuildError> {
+    if shapes.len() != bvh.prim_count as usize {
+        return Err(BuildError::RefitMismatch);
+    }
+    if let Some(index) = shapes.iter().position(|s| !P::shape_is_valid(s)) {
+        return Err(BuildError::InvalidPrimitive { index });
+    }
+    bvh.refit_with(|items| {
+        for it in items {
+            it.set_shape(shapes[it.prim() as usize]);
+        }
+        Ok(())
+    })
 }

@@ -196,3 +196,48 @@ fn mesh_scalars_interpolate_at_hits() {
     assert_eq!(hits, 200);
     assert!(TriangleMesh::new(pos, vec![[0, 1, 2]], Some(vec![0.0])).is_err());
 }
+
+/// Spheres and capsules moved (and resized) by a refit answer like brute
+/// force over the moved shapes; bad refit data change nothing.
+#[test]
+fn sphere_and_capsule_refit_match_brute_force() {
+    let spheres: Vec<Sphere> = (0..60)
+        .map(|i| Sphere::new(Vec3::new((i % 7) as f32, (i / 7) as f32, (i % 3) as f32), 0.3))
+        .collect();
+    let capsules: Vec<Capsule> =
+        spheres.iter().map(|s| Capsule::new(s.center, s.center + Vec3::Z, 0.2)).collect();
+    let mut sb = build_spheres(&spheres, &params()).unwrap();
+    let mut cb = build_capsules(&capsules, &params()).unwrap();
+    let moved_s: Vec<Sphere> = spheres
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            Sphere::new(s.center * 1.7 + Vec3::new(0.0, (i % 4) as f32, 2.0), 0.2 + 0.01 * i as f32)
+        })
+        .collect();
+    let moved_c: Vec<Capsule> = moved_s
+        .iter()
+        .map(|s| Capsule::new(s.center, s.center - 2.0 * Vec3::X, s.radius))
+        .collect();
+    sb.refit_spheres(&moved_s).unwrap();
+    cb.refit_capsules(&moved_c).unwrap();
+    let mut hits = 0;
+    for i in 0..400 {
+        let a = i as f32 * 0.37;
+        let r = Ray::new(
+            Vec3::new(5.0 + 9.0 * a.cos(), 6.0 + 9.0 * a.sin(), 12.0),
+            Vec3::new(-a.cos(), -a.sin(), -1.5),
+        );
+        let want = brute_spheres(&moved_s, &r);
+        assert_eq!(bvh_t(&sb, &r), want);
+        assert_eq!(bvh_t(&cb, &r), brute_capsules(&moved_c, &r));
+        hits += usize::from(want.is_some());
+    }
+    assert!(hits > 40, "only {hits} hits");
+    let before = sb.clone();
+    assert!(sb.refit_spheres(&moved_s[..5]).is_err());
+    let mut bad = moved_s.clone();
+    bad[3].radius = f32::NAN;
+    assert_eq!(sb.refit_spheres(&bad), Err(rt_accel::BuildError::InvalidPrimitive { index: 3 }));
+    assert_eq!(sb, before);
+}

@@ -54,64 +54,8 @@ pub fn bvh_t<P: rt_accel::Primitive>(bvh: &Bvh<P>, ray: &Ray) -> Option<(f32, u3
 
 /// An icosphere subdivided `level` times (closed, shared vertices).
 pub fn icosphere(level: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-    let t = (1.0 + 5.0f32.sqrt()) / 2.0;
-    let mut pos: Vec<Vec3> = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| Vec3::new(x, y, z).normalize())
-    .collect();
-    let mut idx: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid = std::collections::HashMap::new();
-        let mut next = Vec::with_capacity(idx.len() * 4);
-        let mut midpoint = |a: u32, b: u32, pos: &mut Vec<Vec3>| {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                pos.push(((pos[a as usize] + pos[b as usize]) * 0.5).normalize());
-                pos.len() as u32 - 1
-            })
-        };
-        for [a, b, c] in idx {
-            let ab = midpoint(a, b, &mut pos);
-            let bc = midpoint(b, c, &mut pos);
-            let ca = midpoint(c, a, &mut pos);
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        idx = next;
-    }
-    (pos, idx)
+    let m = rt_accel::TriangleMesh::icosphere(level);
+    (m.positions().to_vec(), m.indices().to_vec())
 }
 
 /// A unit cube `[0, 1]³` of 12 triangles, outward counter-clockwise faces.
