@@ -30,7 +30,6 @@ struct Scene {
 type Tracer<'a> = Box<dyn Fn(&[Ray]) -> (u64, f64) + 'a>;
 
 /// Traces every ray with `f`, returning (hits, Σt).
-#[allow(dead_code, reason = "used by the optional implementations")]
 fn count(rays: &[Ray], mut f: impl FnMut(&Ray) -> Option<(f32, u32)>) -> (u64, f64) {
     let (mut n, mut sum) = (0, 0.0);
     for r in rays {
@@ -102,47 +101,30 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
             (
                 "rt",
                 Box::new(|rays: &[Ray]| {
-                    let (mut n, mut sum) = (0, 0.0);
                     let mut stack = TraversalStack::new();
-                    for r in rays {
-                        if let Some(h) = bvh.as_ref().closest_t_with(black_box(r), &mut stack) {
-                            n += 1;
-                            sum += f64::from(h.t);
-                        }
-                    }
-                    (n, sum)
+                    count(rays, |r| {
+                        bvh.as_ref().closest_t_with(r, &mut stack).map(|h| (h.t, h.prim))
+                    })
                 }),
             ),
             (
                 "obvhs-cwbvh",
                 Box::new(|rays: &[Ray]| {
-                    let (mut n, mut sum) = (0, 0.0);
-                    for r in rays {
+                    count(rays, |r| {
                         let mut hit = RayHit::none();
-                        if cw.ray_traverse(to_o(black_box(r)), &mut hit, |ray, id| {
-                            cw_tris[id].intersect(ray)
-                        }) {
-                            n += 1;
-                            sum += f64::from(hit.t);
-                        }
-                    }
-                    (n, sum)
+                        cw.ray_traverse(to_o(r), &mut hit, |ray, id| cw_tris[id].intersect(ray))
+                            .then_some((hit.t, hit.primitive_id))
+                    })
                 }),
             ),
             (
                 "obvhs-bvh2",
                 Box::new(|rays: &[Ray]| {
-                    let (mut n, mut sum) = (0, 0.0);
-                    for r in rays {
+                    count(rays, |r| {
                         let mut hit = RayHit::none();
-                        if b2.ray_traverse(to_o(black_box(r)), &mut hit, |ray, id| {
-                            b2_tris[id].intersect(ray)
-                        }) {
-                            n += 1;
-                            sum += f64::from(hit.t);
-                        }
-                    }
-                    (n, sum)
+                        b2.ray_traverse(to_o(r), &mut hit, |ray, id| b2_tris[id].intersect(ray))
+                            .then_some((hit.t, hit.primitive_id))
+                    })
                 }),
             ),
         ];
