@@ -238,7 +238,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                     continue 'walk;
                 }
                 if k > 1 {
-                    // Sort descending by entry distance (at most 4: insertion
+                    // Sort descending by entry distance (at most 8: insertion
                     // sort), push all but the nearest, descend into it.
                     for a in 1..k {
                         let (r, t) = (refs[a], ts[a]);
