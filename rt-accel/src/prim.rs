@@ -171,6 +171,7 @@ impl Primitive for CapsuleItem {
 
 /// Items that wrap one shape (sphere, capsule) with its primitive index:
 /// lets building and refitting share one code path.
+#[cfg(feature = "alloc")]
 pub(crate) trait ShapeItem: Primitive {
     /// The wrapped shape.
     type Shape: Copy;
@@ -184,6 +185,7 @@ pub(crate) trait ShapeItem: Primitive {
     fn shape_is_valid(shape: &Self::Shape) -> bool;
 }
 
+#[cfg(feature = "alloc")]
 impl ShapeItem for SphereItem {
     type Shape = Sphere;
     fn wrap(sphere: Sphere, prim: u32) -> Self {
@@ -200,6 +202,7 @@ impl ShapeItem for SphereItem {
     }
 }
 
+#[cfg(feature = "alloc")]
 impl ShapeItem for CapsuleItem {
     type Shape = Capsule;
     fn wrap(capsule: Capsule, prim: u32) -> Self {
