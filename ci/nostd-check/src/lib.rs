@@ -25,12 +25,32 @@ pub fn trace(bytes: &[u8], origin: [f32; 3], direction: [f32; 3]) -> f32 {
     }
 }
 
+/// Height at which a ray launched along +x at the origin leaves the unit
+/// box through a linear index `n = 1 + g·y` (a catenary), or NaN on error.
+#[must_use]
+pub fn bend(g: f64) -> f64 {
+    use rt_volume::{Bounds, LinearIndex, TraceParams, glam::DVec3};
+    let v = DVec3::new;
+    let f = LinearIndex {
+        n0: 1.0,
+        gradient: v(0.0, g, 0.0),
+        bounds: Bounds::new(v(0.0, -1.0, -1.0), v(1.0, 1.0, 1.0)),
+    };
+    rt_volume::trace(&f, v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), &TraceParams::accurate())
+        .map_or(f64::NAN, |r| r.position.y)
+}
+
 /// C entry point so the static library exports something.
 ///
 /// # Safety
 /// `bytes` must point to `len` readable bytes, `o` and `d` to 3 floats each.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn rt_trace(bytes: *const u8, len: usize, o: *const f32, d: *const f32) -> f32 {
+pub unsafe extern "C" fn rt_trace(
+    bytes: *const u8,
+    len: usize,
+    o: *const f32,
+    d: *const f32,
+) -> f32 {
     // SAFETY: the caller guarantees the pointers and lengths.
     let (b, o, d) = unsafe {
         (core::slice::from_raw_parts(bytes, len), *o.cast::<[f32; 3]>(), *d.cast::<[f32; 3]>())

@@ -1,0 +1,183 @@
+//! Analytic index fields: the closed-form cases of `ORACLES.md` and any
+//! user closure pair.
+
+use glam::DVec3;
+
+use crate::{
+    Bounds, IndexField,
+    math::{exp, sqrt},
+};
+
+/// `n = n₀` everywhere in the bounds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Constant {
+    /// The index.
+    pub n: f64,
+    /// Where the field is defined.
+    pub bounds: Bounds,
+}
+
+impl IndexField for Constant {
+    fn eval(&self, _x: DVec3) -> (f64, DVec3) {
+        (self.n, DVec3::ZERO)
+    }
+    fn bounds(&self) -> Bounds {
+        self.bounds
+    }
+    fn ambient(&self) -> f64 {
+        self.n
+    }
+}
+
+/// Linear index `n = n₀ + g·x` (rays are catenaries, ORACLES §1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinearIndex {
+    /// Index at the origin.
+    pub n0: f64,
+    /// Constant gradient.
+    pub gradient: DVec3,
+    /// Where the field is defined.
+    pub bounds: Bounds,
+}
+
+impl IndexField for LinearIndex {
+    fn eval(&self, x: DVec3) -> (f64, DVec3) {
+        (self.n0 + self.gradient.dot(x), self.gradient)
+    }
+    fn bounds(&self) -> Bounds {
+        self.bounds
+    }
+}
+
+/// Linear `n² = n₀² + a·x` (rays are parabolas, ORACLES §2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinearSquared {
+    /// Index at the origin.
+    pub n0: f64,
+    /// Gradient of `n²`.
+    pub a: DVec3,
+    /// Where the field is defined.
+    pub bounds: Bounds,
+}
+
+impl IndexField for LinearSquared {
+    fn eval(&self, x: DVec3) -> (f64, DVec3) {
+        let n = sqrt(self.n0 * self.n0 + self.a.dot(x));
+        (n, self.a / (2.0 * n))
+    }
+    fn bounds(&self) -> Bounds {
+        self.bounds
+    }
+}
+
+/// Parabolic GRIN rod about the z axis: `n² = n₀²(1 − α² r²)`, `r² = x² + y²`
+/// (ORACLES §3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GrinRod {
+    /// Index on the axis.
+    pub n0: f64,
+    /// Gradient constant `α` (1/length).
+    pub alpha: f64,
+    /// Where the field is defined.
+    pub bounds: Bounds,
+}
+
+impl IndexField for GrinRod {
+    fn eval(&self, x: DVec3) -> (f64, DVec3) {
+        let r2 = x.x * x.x + x.y * x.y;
+        let n2 = self.n0 * self.n0 * (1.0 - self.alpha * self.alpha * r2);
+        let n = sqrt(n2);
+        let k = -self.n0 * self.n0 * self.alpha * self.alpha / n;
+        (n, DVec3::new(k * x.x, k * x.y, 0.0))
+    }
+    fn bounds(&self) -> Bounds {
+        self.bounds
+    }
+}
+
+/// Luneburg lens of radius `R` at `center`: `n = √(2 − r²/R²)` inside,
+/// `1` outside (ORACLES §4). Bounds: the cube around the sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Luneburg {
+    /// Centre.
+    pub center: DVec3,
+    /// Radius.
+    pub radius: f64,
+}
+
+impl IndexField for Luneburg {
+    fn eval(&self, x: DVec3) -> (f64, DVec3) {
+        let d = x - self.center;
+        let r2 = d.length_squared() / (self.radius * self.radius);
+        if r2 >= 1.0 {
+            return (1.0, DVec3::ZERO);
+        }
+        let n = sqrt(2.0 - r2);
+        (n, -d / (self.radius * self.radius * n))
+    }
+    fn bounds(&self) -> Bounds {
+        let r = DVec3::splat(self.radius);
+        Bounds::new(self.center - r, self.center + r)
+    }
+}
+
+/// Gaussian bump `n = n_a + δ·exp(−ρ²/(2σ²))`, `ρ = |x − c|` (ORACLES §5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GaussianBump {
+    /// Centre.
+    pub center: DVec3,
+    /// Peak index excess `δ`.
+    pub delta: f64,
+    /// Width `σ`.
+    pub sigma: f64,
+    /// Ambient index `n_a`.
+    pub ambient: f64,
+    /// Where the field is evaluated (outside: `n_a`); a few `σ` around `c`.
+    pub bounds: Bounds,
+}
+
+impl GaussianBump {
+    /// A bump on ambient index 1, evaluated within `k·σ` of the centre.
+    #[must_use]
+    pub fn new(center: DVec3, delta: f64, sigma: f64, k: f64) -> Self {
+        let r = DVec3::splat(k * sigma);
+        Self { center, delta, sigma, ambient: 1.0, bounds: Bounds::new(center - r, center + r) }
+    }
+}
+
+impl IndexField for GaussianBump {
+    fn eval(&self, x: DVec3) -> (f64, DVec3) {
+        let d = x - self.center;
+        let g = exp(-d.length_squared() / (2.0 * self.sigma * self.sigma));
+        (self.ambient + self.delta * g, -self.delta * g / (self.sigma * self.sigma) * d)
+    }
+    fn bounds(&self) -> Bounds {
+        self.bounds
+    }
+    fn ambient(&self) -> f64 {
+        self.ambient
+    }
+}
+
+/// Any field from a closure returning `(n, ∇n)`.
+#[derive(Clone, Copy, Debug)]
+pub struct FnField<F> {
+    /// `x ↦ (n(x), ∇n(x))`.
+    pub f: F,
+    /// Where the field is defined.
+    pub bounds: Bounds,
+    /// Index outside the bounds.
+    pub ambient: f64,
+}
+
+impl<F: Fn(DVec3) -> (f64, DVec3)> IndexField for FnField<F> {
+    fn eval(&self, x: DVec3) -> (f64, DVec3) {
+        (self.f)(x)
+    }
+    fn bounds(&self) -> Bounds {
+        self.bounds
+    }
+    fn ambient(&self) -> f64 {
+        self.ambient
+    }
+}

@@ -1,0 +1,477 @@
+//! Integrating the ray equation `d/ds (n dx/ds) = ∇n`.
+//!
+//! With the parameter `dt = ds/n` and `T = n dx/ds` the equation becomes
+//! the first-order system `dx/dt = T`, `dT/dt = n∇n = ½∇(n²)`, with the
+//! invariant `|T| = n`; the optical path obeys `d(OPL)/dt = n²`. The system
+//! is Hamiltonian (`H = ½|T|² − ½n²(x)`, separable), which the symplectic
+//! leapfrog scheme exploits. Step sizes are in `t`, which equals arc length
+//! where `n = 1`.
+
+use core::fmt;
+
+use glam::DVec3;
+
+use crate::{IndexField, math::powf};
+
+/// The integration scheme.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Explicit Euler, first order: the original tool's scheme, kept as the
+    /// baseline. One field evaluation per step.
+    Euler,
+    /// Classic fourth-order Runge–Kutta; four evaluations per step.
+    Rk4,
+    /// Dormand–Prince 5(4) with error control (local error per step ≤
+    /// `tolerance`, absolute in position and `T`); seven evaluations per
+    /// attempt.
+    Adaptive,
+    /// Störmer–Verlet leapfrog (kick–drift–kick), second order, symplectic:
+    /// `|T|² − n²` stays bounded on long paths. One evaluation per step.
+    Symplectic,
+}
+
+impl Method {
+    /// Every method.
+    pub const ALL: [Self; 4] = [Self::Euler, Self::Rk4, Self::Adaptive, Self::Symplectic];
+
+    /// Lower-case name.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Euler => "euler",
+            Self::Rk4 => "rk4",
+            Self::Adaptive => "adaptive",
+            Self::Symplectic => "symplectic",
+        }
+    }
+}
+
+/// Integration settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TraceParams {
+    /// The scheme.
+    pub method: Method,
+    /// Step in `t` (fixed-step methods; the first trial step for `Adaptive`).
+    pub step: f64,
+    /// Local error bound per step (`Adaptive` only).
+    pub tolerance: f64,
+    /// Largest step the adaptive control may grow to. Keep it below the
+    /// field's smallest feature (a grid spacing, a layer's width): a step
+    /// whose stages all fall outside a thin layer cannot see it.
+    pub max_step: f64,
+    /// Most steps (accepted + rejected) before giving up.
+    pub max_steps: u32,
+    /// Longest path (in `t`) inside the bounds before giving up.
+    pub max_length: f64,
+}
+
+impl TraceParams {
+    /// Adaptive Dormand–Prince with a tight tolerance (1e-10).
+    #[must_use]
+    pub const fn accurate() -> Self {
+        Self {
+            method: Method::Adaptive,
+            step: 1e-2,
+            tolerance: 1e-10,
+            max_step: f64::INFINITY,
+            max_steps: 1_000_000,
+            max_length: 1e6,
+        }
+    }
+
+    /// A fixed-step method with step `step`.
+    #[must_use]
+    pub const fn fixed(method: Method, step: f64) -> Self {
+        Self {
+            method,
+            step,
+            tolerance: 1e-10,
+            max_step: f64::INFINITY,
+            max_steps: 10_000_000,
+            max_length: 1e6,
+        }
+    }
+}
+
+/// Work done and error measured while tracing.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TraceStats {
+    /// Steps taken (accepted), including the final partial step(s) that
+    /// land on the boundary.
+    pub steps: u32,
+    /// Field evaluations (calls to [`IndexField::eval`]).
+    pub field_evals: u32,
+    /// Rejected adaptive steps.
+    pub rejected: u32,
+    /// Sum of the embedded local error estimates (`Adaptive`; 0 otherwise).
+    pub error_estimate: f64,
+    /// Largest `| |T| − n |` seen at step ends (the invariant's drift).
+    pub invariant_drift: f64,
+}
+
+/// How a trace ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Exit {
+    /// The ray never entered the bounds: it went straight.
+    Missed,
+    /// The ray left the bounds; position is on their surface.
+    Left,
+    /// `max_steps` ran out (position is where it stopped).
+    MaxSteps,
+    /// `max_length` ran out.
+    MaxLength,
+}
+
+/// The result of tracing one ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TraceResult {
+    /// Where the ray left the bounds (or stopped; the origin if it missed).
+    pub position: DVec3,
+    /// Unit direction there.
+    pub direction: DVec3,
+    /// Optical path `∫ n ds` from the origin to `position`.
+    pub optical_path: f64,
+    /// How it ended.
+    pub exit: Exit,
+    /// Work and error.
+    pub stats: TraceStats,
+}
+
+/// Why a ray could not be traced.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TraceError {
+    /// Origin or direction not finite, or a zero direction.
+    InvalidRay,
+    /// Step, tolerance or limits not finite and positive.
+    InvalidParams,
+    /// The field returned a NaN/∞ index or gradient (or `n ≤ 0`) at a point.
+    BadField {
+        /// Where.
+        at: DVec3,
+    },
+}
+
+impl fmt::Display for TraceError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::InvalidRay => write!(f, "ray origin/direction not finite or zero"),
+            Self::InvalidParams => write!(f, "trace parameters must be finite and positive"),
+            Self::BadField { at } => write!(f, "field is not finite and positive at {at}"),
+        }
+    }
+}
+
+impl core::error::Error for TraceError {}
+
+/// The integrated state: position, `T = n dx/ds`, optical path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct State {
+    x: DVec3,
+    t: DVec3,
+    opl: f64,
+}
+
+impl State {
+    fn axpy(self, h: f64, d: &State) -> State {
+        State { x: self.x + h * d.x, t: self.t + h * d.t, opl: self.opl + h * d.opl }
+    }
+}
+
+/// Field access that never evaluates outside the bounds and counts calls.
+struct Eval<'a, F: IndexField> {
+    field: &'a F,
+    bounds: crate::Bounds,
+    ambient: f64,
+    evals: u32,
+    /// The last evaluation: steps that end where the next begins (FSAL,
+    /// leapfrog) reuse it instead of calling the field again.
+    last: Option<(DVec3, f64, DVec3)>,
+}
+
+impl<F: IndexField> Eval<'_, F> {
+    /// `(n, ∇n)`, ambient outside the bounds.
+    fn n(&mut self, x: DVec3) -> Result<(f64, DVec3), TraceError> {
+        if !self.bounds.contains(x) {
+            return Ok((self.ambient, DVec3::ZERO));
+        }
+        if let Some((lx, n, g)) = self.last
+            && lx == x
+        {
+            return Ok((n, g));
+        }
+        self.evals += 1;
+        let (n, g) = self.field.eval(x);
+        if !(n.is_finite() && n > 0.0 && g.is_finite()) {
+            return Err(TraceError::BadField { at: x });
+        }
+        self.last = Some((x, n, g));
+        Ok((n, g))
+    }
+
+    /// `dy/dt = (T, n∇n, n²)`.
+    fn deriv(&mut self, y: &State) -> Result<State, TraceError> {
+        let (n, g) = self.n(y.x)?;
+        Ok(State { x: y.t, t: n * g, opl: n * n })
+    }
+}
+
+/// Traces a ray from `origin` along `direction` (any non-zero length)
+/// through `field`: straight to the bounds, integrated inside them, and
+/// stopped exactly on the bounds' surface where it leaves.
+///
+/// # Errors
+/// [`TraceError`] for a bad ray, bad parameters, or a field returning a
+/// non-finite or non-positive index.
+pub fn trace<F: IndexField>(
+    field: &F,
+    origin: DVec3,
+    direction: DVec3,
+    params: &TraceParams,
+) -> Result<TraceResult, TraceError> {
+    if !(origin.is_finite() && direction.is_finite()) || direction == DVec3::ZERO {
+        return Err(TraceError::InvalidRay);
+    }
+    let ok = |v: f64| v.is_finite() && v > 0.0;
+    if !(ok(params.step) && ok(params.tolerance) && ok(params.max_length)) || params.max_steps == 0
+    {
+        return Err(TraceError::InvalidParams);
+    }
+    let d = direction.normalize();
+    let bounds = field.bounds();
+    let ambient = field.ambient();
+    let mut ev = Eval { field, bounds, ambient, evals: 0, last: None };
+    let mut stats = TraceStats::default();
+    let Some((t0, _)) = bounds.clip(origin, d) else {
+        return Ok(TraceResult {
+            position: origin,
+            direction: d,
+            optical_path: 0.0,
+            exit: Exit::Missed,
+            stats,
+        });
+    };
+    // Straight through the ambient medium to the entry point.
+    let x0 = origin + t0 * d;
+    let (n0, _) = ev.n(x0)?;
+    let mut y = State { x: x0, t: n0 * d, opl: ambient * t0 };
+    let mut h = params.step.min(params.max_step);
+    let mut travelled = 0.0;
+    let mut exit = Exit::Left;
+    loop {
+        if stats.steps + stats.rejected >= params.max_steps {
+            exit = Exit::MaxSteps;
+            break;
+        }
+        if travelled >= params.max_length {
+            exit = Exit::MaxLength;
+            break;
+        }
+        let (next, used, err) = match params.method {
+            Method::Adaptive => adaptive_step(&mut ev, &y, &mut h, params, &mut stats)?,
+            m => (fixed_step(m, &mut ev, &y, h)?, h, 0.0),
+        };
+        if bounds.contains(next.x) {
+            y = next;
+            travelled += used;
+            stats.steps += 1;
+            stats.error_estimate += err;
+            let (n, _) = ev.n(y.x)?;
+            stats.invariant_drift = stats.invariant_drift.max((y.t.length() - n).abs());
+            stats.field_evals = ev.evals;
+            continue;
+        }
+        // The step leaves the bounds: land exactly on the exit face.
+        y = land_on_boundary(params.method, &mut ev, &y, &next, used, &mut stats)?;
+        break;
+    }
+    stats.field_evals = ev.evals;
+    let (n, _) = ev.n(y.x)?;
+    stats.invariant_drift = stats.invariant_drift.max((y.t.length() - n).abs());
+    Ok(TraceResult { position: y.x, direction: y.t.normalize(), optical_path: y.opl, exit, stats })
+}
+
+/// One step of a fixed-step method.
+fn fixed_step<F: IndexField>(
+    m: Method,
+    ev: &mut Eval<'_, F>,
+    y: &State,
+    h: f64,
+) -> Result<State, TraceError> {
+    Ok(match m {
+        Method::Euler => {
+            let k = ev.deriv(y)?;
+            y.axpy(h, &k)
+        }
+        Method::Rk4 | Method::Adaptive => {
+            let k1 = ev.deriv(y)?;
+            let k2 = ev.deriv(&y.axpy(0.5 * h, &k1))?;
+            let k3 = ev.deriv(&y.axpy(0.5 * h, &k2))?;
+            let k4 = ev.deriv(&y.axpy(h, &k3))?;
+            State {
+                x: y.x + h / 6.0 * (k1.x + 2.0 * k2.x + 2.0 * k3.x + k4.x),
+                t: y.t + h / 6.0 * (k1.t + 2.0 * k2.t + 2.0 * k3.t + k4.t),
+                opl: y.opl + h / 6.0 * (k1.opl + 2.0 * k2.opl + 2.0 * k3.opl + k4.opl),
+            }
+        }
+        Method::Symplectic => {
+            // Kick–drift–kick; the optical path by the trapezoid rule.
+            let (n_a, g_a) = ev.n(y.x)?;
+            let t_half = y.t + 0.5 * h * n_a * g_a;
+            let x = y.x + h * t_half;
+            let (n_b, g_b) = ev.n(x)?;
+            State {
+                x,
+                t: t_half + 0.5 * h * n_b * g_b,
+                opl: y.opl + 0.5 * h * (n_a * n_a + n_b * n_b),
+            }
+        }
+    })
+}
+
+// Dormand–Prince 5(4) tableau (Dormand & Prince 1980).
+const A: [[f64; 6]; 6] = [
+    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0, 0.0],
+    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0, 0.0],
+    [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0],
+];
+/// 5th-order weights (= last row of `A`, FSAL).
+const B5: [f64; 7] =
+    [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0, 0.0];
+/// 4th-order weights.
+const B4: [f64; 7] = [
+    5179.0 / 57600.0,
+    0.0,
+    7571.0 / 16695.0,
+    393.0 / 640.0,
+    -92097.0 / 339200.0,
+    187.0 / 2100.0,
+    1.0 / 40.0,
+];
+
+/// One Dormand–Prince step of size `h`: the 5th-order result and the
+/// max-norm of its difference from the 4th-order one (position and `T`).
+fn dopri<F: IndexField>(
+    ev: &mut Eval<'_, F>,
+    y: &State,
+    h: f64,
+) -> Result<(State, f64), TraceError> {
+    let mut k = [*y; 7];
+    k[0] = ev.deriv(y)?;
+    for s in 1..7 {
+        let mut yi = *y;
+        for (j, a) in A[s - 1].iter().enumerate().take(s) {
+            yi = yi.axpy(h * a, &k[j]);
+        }
+        k[s] = ev.deriv(&yi)?;
+    }
+    let (mut y5, mut y4) = (*y, *y);
+    for s in 0..7 {
+        y5 = y5.axpy(h * B5[s], &k[s]);
+        y4 = y4.axpy(h * B4[s], &k[s]);
+    }
+    let err = (y5.x - y4.x).abs().max_element().max((y5.t - y4.t).abs().max_element());
+    Ok((y5, err))
+}
+
+/// An accepted adaptive step: `(state, step used, local error)`; adapts `h`.
+fn adaptive_step<F: IndexField>(
+    ev: &mut Eval<'_, F>,
+    y: &State,
+    h: &mut f64,
+    params: &TraceParams,
+    stats: &mut TraceStats,
+) -> Result<(State, f64, f64), TraceError> {
+    loop {
+        let (next, err) = dopri(ev, y, *h)?;
+        // Standard controller: safety 0.9, growth in [0.2, 5].
+        let factor = if err > 0.0 { 0.9 * powf(params.tolerance / err, 0.2) } else { 5.0 };
+        let factor = factor.clamp(0.2, 5.0);
+        if err <= params.tolerance {
+            let used = *h;
+            *h = (*h * factor).min(params.max_step);
+            return Ok((next, used, err));
+        }
+        stats.rejected += 1;
+        *h *= factor;
+        if stats.rejected + stats.steps >= params.max_steps || *h < 1e-300 {
+            // Give up controlling: accept (the caller stops on max_steps).
+            return Ok((next, *h / factor, err));
+        }
+    }
+}
+
+/// Finds the step `h* ∈ (0, h]` from `y` whose end lies on the bounds face
+/// the step crossed, by the Illinois variant of regula falsi on the signed
+/// distance to that face, and returns the state there.
+fn land_on_boundary<F: IndexField>(
+    m: Method,
+    ev: &mut Eval<'_, F>,
+    y: &State,
+    outside: &State,
+    h: f64,
+    stats: &mut TraceStats,
+) -> Result<State, TraceError> {
+    let b = ev.bounds;
+    // Signed distance outside the box, per unit of box size: ≤ 0 inside,
+    // > 0 outside; its zero on the step is where the ray leaves.
+    let size = (b.max - b.min).max(DVec3::splat(f64::MIN_POSITIVE));
+    let outside_by = |s: &State| -> (f64, usize, f64) {
+        let mut worst = (f64::NEG_INFINITY, 0, 0.0);
+        for a in 0..3 {
+            for (over, plane) in [
+                ((s.x[a] - b.max[a]) / size[a], b.max[a]),
+                ((b.min[a] - s.x[a]) / size[a], b.min[a]),
+            ] {
+                if over > worst.0 {
+                    worst = (over, a, plane);
+                }
+            }
+        }
+        worst
+    };
+    let g = |s: &State| outside_by(s).0;
+    let step = |ev: &mut Eval<'_, F>, hh: f64| -> Result<State, TraceError> {
+        match m {
+            Method::Adaptive => dopri(ev, y, hh).map(|r| r.0),
+            _ => fixed_step(m, ev, y, hh),
+        }
+    };
+    let (mut lo, mut g_lo) = (0.0, g(y));
+    let (mut hi, mut g_hi) = (h, g(outside));
+    let mut landed = *outside;
+    let mut side = 0i8;
+    let tol = 1e-14;
+    for _ in 0..60 {
+        let hm = if g_hi != g_lo { hi - g_hi * (hi - lo) / (g_hi - g_lo) } else { 0.5 * (lo + hi) };
+        let hm = if hm > lo && hm < hi { hm } else { 0.5 * (lo + hi) };
+        let s = step(ev, hm)?;
+        let gm = g(&s);
+        landed = s;
+        if gm.abs() <= tol || hi - lo <= 1e-15 * h {
+            break;
+        }
+        if gm > 0.0 {
+            hi = hm;
+            g_hi = gm;
+            if side == 1 {
+                g_lo *= 0.5;
+            }
+            side = 1;
+        } else {
+            lo = hm;
+            g_lo = gm;
+            if side == -1 {
+                g_hi *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    // Snap the exit coordinate onto the face it is on (within `tol`).
+    let (_, axis, plane) = outside_by(&landed);
+    landed.x[axis] = plane;
+    stats.steps += 1;
+    Ok(landed)
+}
