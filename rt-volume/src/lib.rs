@@ -19,7 +19,8 @@
 //! ## Features
 //! | feature | default | what it does |
 //! |---|---|---|
-//! | `std` | yes | std float functions |
+//! | `std` | yes | std float functions; implies `alloc` |
+//! | `alloc` | via `std` | gridded fields ([`Grid`], [`GridField`]) |
 //! | `libm` | no | float functions from `libm` for `no_std` |
 //!
 //! ## Example
@@ -38,11 +39,16 @@
 //! ```
 #![no_std]
 
+#[cfg(feature = "alloc")]
+extern crate alloc;
 #[cfg(feature = "std")]
 extern crate std;
 
 mod analytic;
 mod field;
+#[cfg(feature = "alloc")]
+mod grid;
+mod mapping;
 mod math;
 mod trace;
 
@@ -50,6 +56,9 @@ pub use analytic::{
     Constant, FnField, GaussianBump, GrinRod, LinearIndex, LinearSquared, Luneburg,
 };
 pub use field::{Bounds, IndexField};
+#[cfg(feature = "alloc")]
+pub use grid::{Grid, GridError, GridField, Interp};
+pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
 pub use trace::{Exit, Method, TraceError, TraceParams, TraceResult, TraceStats, trace};
 
 pub use glam;
