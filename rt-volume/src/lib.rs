@@ -22,6 +22,7 @@
 //! | `std` | yes | std float functions; implies `alloc` |
 //! | `alloc` | via `std` | gridded fields ([`Grid`], [`GridField`]) |
 //! | `libm` | no | float functions from `libm` for `no_std` |
+//! | `io` | no | readers ([`io`]): raw + JSON header, NRRD |
 //!
 //! ## Example
 //! ```
@@ -48,6 +49,8 @@ mod analytic;
 mod field;
 #[cfg(feature = "alloc")]
 mod grid;
+#[cfg(feature = "io")]
+pub mod io;
 mod mapping;
 mod math;
 mod trace;

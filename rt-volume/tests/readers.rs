@@ -1,0 +1,103 @@
+//! File readers (feature `io`): the project's real CFD data, and every kind
+//! of malformed input as an `Err`.
+#![cfg(feature = "io")]
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use rt_volume::io::{ReadError, parse_nrrd, read_grid};
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data").join(name)
+}
+
+/// The blast wave through both formats: same geometry and samples, the
+/// statistics its provenance records (min, max, mean).
+#[test]
+fn blast_wave_reads_identically_from_nrrd_and_raw_json() {
+    let a = read_grid(&data("blast_sedov_64.nrrd")).expect("nrrd");
+    let b = read_grid(&data("blast_sedov_64.json")).expect("raw + json");
+    assert_eq!(a, b);
+    assert_eq!(a.dims(), [64, 64, 64]);
+    assert_eq!(a.spacing(), DVec3::splat(0.015625));
+    assert_eq!(a.origin(), DVec3::splat(-0.4921875));
+    let b = a.bounds();
+    assert_eq!((b.min, b.max), (DVec3::splat(-0.5), DVec3::splat(0.5)));
+    let d = a.data();
+    let (min, max) = d.iter().fold((f32::MAX, f32::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let mean = d.iter().map(|&v| f64::from(v)).sum::<f64>() / d.len() as f64;
+    assert!((min - 0.018_673_161).abs() < 1e-8 && (max - 2.849_521_6).abs() < 1e-6);
+    assert!((mean - 1.0).abs() < 1e-6, "mass conserved: mean {mean}");
+}
+
+fn header(body: &str) -> Vec<u8> {
+    let mut v = format!("NRRD0004\n{body}\n\n").into_bytes();
+    v.extend([0u8; 8 * 4]);
+    v
+}
+
+/// Malformed NRRD headers and payloads are errors naming the problem.
+#[test]
+fn malformed_nrrd_is_an_error() {
+    let ok = "type: float\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nendian: little";
+    assert!(parse_nrrd(&header(ok), None).is_ok());
+    for bytes in [&b"P6 not nrrd"[..], b"NRRD0004\ntype: float"] {
+        let e = parse_nrrd(bytes, None).unwrap_err();
+        assert!(matches!(e, ReadError::Malformed(_)), "{e}");
+    }
+    for (body, want) in [
+        ("type: float\ndimension: 2\nsizes: 2 2\nencoding: raw", "dimension"),
+        ("type: complex\ndimension: 3\nsizes: 2 2 2\nencoding: raw", "type"),
+        ("type: float\ndimension: 3\nsizes: 2 2 2\nencoding: gzip", "encoding"),
+        ("type: float\ndimension: 3\nsizes: 2 x 2\nencoding: raw", "sizes"),
+        ("dimension: 3\nsizes: 2 2 2\nencoding: raw", "type"),
+        ("type: float\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nspacings: 1 nan", "spacings"),
+        ("type: float\ndimension: 3\nencoding: raw", "sizes"),
+    ] {
+        let e = parse_nrrd(&header(body), None).unwrap_err();
+        assert!(e.to_string().contains(want), "{body:?}: {e}");
+    }
+    // Truncated payload, and counts that overflow.
+    let mut short = header(ok);
+    short.truncate(short.len() - 3);
+    assert!(matches!(
+        parse_nrrd(&short, None),
+        Err(ReadError::Truncated { expected: 32, found: 29 })
+    ));
+    let huge =
+        header("type: float\ndimension: 3\nsizes: 4294967296 4294967296 4294967296\nencoding: raw");
+    assert!(matches!(parse_nrrd(&huge, None), Err(ReadError::Grid(_))));
+    // NaN samples.
+    let mut nan = header(ok);
+    let n = nan.len();
+    nan[n - 4..].copy_from_slice(&f32::NAN.to_le_bytes());
+    assert!(matches!(
+        parse_nrrd(&nan, None),
+        Err(ReadError::Grid(rt_volume::GridError::NonFinite { index: 7 }))
+    ));
+    // Zero spacing.
+    let zero = header("type: float\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nspacings: 1 0 1");
+    assert!(matches!(
+        parse_nrrd(&zero, None),
+        Err(ReadError::Grid(rt_volume::GridError::BadGeometry))
+    ));
+}
+
+/// Missing files and bad JSON headers are errors too.
+#[test]
+fn missing_files_and_bad_json_are_errors() {
+    assert!(matches!(read_grid(Path::new("/nonexistent/x.nrrd")), Err(ReadError::Io { .. })));
+    assert!(matches!(read_grid(Path::new("x.vtk")), Err(ReadError::Unsupported(_))));
+    let v: serde_json::Value =
+        serde_json::json!({"dims": [2, 2], "spacing": [1, 1, 1], "origin": [0, 0, 0]});
+    assert!(rt_volume::io::parse_raw_json(&v, &[0; 32]).is_err());
+    let v: serde_json::Value =
+        serde_json::json!({"dims": [2, 2, 2], "spacing": [1, 1, 1], "origin": [0, 0, 0]});
+    assert!(rt_volume::io::parse_raw_json(&v, &[0; 32]).is_ok());
+    assert!(matches!(
+        rt_volume::io::parse_raw_json(&v, &[0; 31]),
+        Err(ReadError::Truncated { .. })
+    ));
+    let v: serde_json::Value = serde_json::json!({"dims": [2, 2, 2], "dtype": "complex64", "spacing": [1, 1, 1], "origin": [0, 0, 0]});
+    assert!(matches!(rt_volume::io::parse_raw_json(&v, &[0; 32]), Err(ReadError::Unsupported(_))));
+}
