@@ -4,4 +4,5 @@
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
 pub mod image;
+pub mod plot;
 pub mod scenes;

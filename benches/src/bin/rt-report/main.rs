@@ -3,6 +3,7 @@
 //!
 //! ```text
 //! cargo run --release -p rt-benches --bin rt-report -- traversal [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- grin [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- all [--quick]
 //! ```
 // A std-only tool crate: the no_std import lints guard the libraries.
@@ -10,6 +11,7 @@
 
 #[cfg(feature = "embree3")]
 mod embree3;
+mod grin;
 mod timing;
 #[cfg(feature = "tinybvh")]
 mod tinybvh;
@@ -31,7 +33,8 @@ fn main() -> ExitCode {
     let quick = args.iter().any(|a| a == "--quick");
     let areas: Vec<&str> =
         args.iter().filter(|a| !a.starts_with("--")).map(String::as_str).collect();
-    let areas = if areas.is_empty() || areas == ["all"] { vec!["traversal"] } else { areas };
+    let areas =
+        if areas.is_empty() || areas == ["all"] { vec!["traversal", "grin"] } else { areas };
     let dir = out_dir();
     if let Err(e) = std::fs::create_dir_all(&dir) {
         eprintln!("cannot create {}: {e}", dir.display());
@@ -40,7 +43,8 @@ fn main() -> ExitCode {
     for area in areas {
         let result = match area {
             "traversal" => traversal::run(&dir, quick),
-            other => Err(format!("unknown area `{other}` (known: traversal, all)")),
+            "grin" => grin::run(&dir, quick),
+            other => Err(format!("unknown area `{other}` (known: traversal, grin, all)")),
         };
         if let Err(e) = result {
             eprintln!("rt-report {area}: {e}");
