@@ -97,6 +97,9 @@ fn gaussian() -> (GaussianBump, Vec<Probe>) {
 /// One row: (tolerance-or-step, steps, evals, seconds, max error, max drift).
 type Row = (f64, u64, u64, f64, f64, f64);
 
+/// Runs one parameter setting over a case's probes.
+type Case<'a> = &'a dyn Fn(&TraceParams) -> Row;
+
 fn sweep<F: IndexField>(field: &F, probes: &[Probe], p: &TraceParams) -> Row {
     let run = || {
         let (mut steps, mut evals, mut err, mut drift) = (0u64, 0u64, 0.0f64, 0.0f64);
@@ -146,7 +149,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
     let (gf, gp) = grin_rod();
     let (uf, up) = luneburg();
     let (bf, bp) = gaussian();
-    let cases: [(&str, &dyn Fn(&TraceParams) -> Row); 4] = [
+    let cases: [(&str, Case<'_>); 4] = [
         ("linear", &|p| sweep(&lf, &lp, p)),
         ("grin-rod", &|p| sweep(&gf, &gp, p)),
         ("luneburg", &|p| sweep(&uf, &up, p)),
@@ -156,7 +159,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
         let mut series = Vec::new();
         let mut rows_by_method = Vec::new();
         for (mi, m) in Method::ALL.into_iter().enumerate() {
-            let rows: Vec<Row> = params(m, quick).iter().map(|p| f(p)).collect();
+            let rows: Vec<Row> = params(m, quick).iter().map(f).collect();
             for r in &rows {
                 writeln!(
                     csv,
