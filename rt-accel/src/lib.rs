@@ -55,6 +55,7 @@ mod error;
 #[cfg(feature = "alloc")]
 mod mesh;
 mod node;
+mod octree;
 mod prim;
 mod ray_ctx;
 #[cfg(feature = "alloc")]
@@ -74,6 +75,9 @@ pub use error::{BuildError, LoadError};
 #[cfg(feature = "alloc")]
 pub use mesh::TriangleMesh;
 pub use node::{ChildRef, GROUPS, MAX_ITEMS, MAX_LEAF_ITEMS, Node, WIDTH};
+#[cfg(feature = "alloc")]
+pub use octree::Octree;
+pub use octree::{BRICK, OctNode, OctreeError, SmoothNode};
 pub use prim::{BestHit, CapsuleItem, Primitive, SphereItem};
 pub use ray_ctx::RayCtx;
 #[cfg(feature = "alloc")]

@@ -176,6 +176,7 @@ pub(crate) trait ShapeItem: Primitive {
     /// The wrapped shape.
     type Shape: Copy;
     /// The item for shape `prim`.
+    #[cfg_attr(not(feature = "obvhs"), allow(dead_code, reason = "used by the builder"))]
     fn wrap(shape: Self::Shape, prim: u32) -> Self;
     /// Replaces the shape (refit).
     fn set_shape(&mut self, shape: Self::Shape);

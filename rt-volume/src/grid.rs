@@ -325,6 +325,12 @@ impl GridField {
     pub fn grid(&self) -> &Grid {
         &self.grid
     }
+
+    /// The interpolant.
+    #[must_use]
+    pub fn interp(&self) -> Interp {
+        self.interp
+    }
 }
 
 impl IndexField for GridField {

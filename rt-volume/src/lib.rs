@@ -53,6 +53,8 @@ mod grid;
 pub mod io;
 mod mapping;
 mod math;
+#[cfg(feature = "alloc")]
+mod skip;
 mod trace;
 
 pub use analytic::{
@@ -62,6 +64,8 @@ pub use field::{Bounds, IndexField};
 #[cfg(feature = "alloc")]
 pub use grid::{Grid, GridError, GridField, Interp};
 pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
+#[cfg(feature = "alloc")]
+pub use skip::{build_octree, trace_skipping};
 pub use trace::{Exit, Method, TraceError, TraceParams, TraceResult, TraceStats, trace};
 
 pub use glam;

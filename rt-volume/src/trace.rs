@@ -107,6 +107,11 @@ pub struct TraceStats {
     pub error_estimate: f64,
     /// Largest `| |T| − n |` seen at step ends (the invariant's drift).
     pub invariant_drift: f64,
+    /// Straight steps across smooth octree nodes (skipping tracers only).
+    pub skipped: u32,
+    /// Sum over those steps of the deflection each may have missed
+    /// (`max|∇n| · length / min n` of its node).
+    pub skip_bound: f64,
 }
 
 /// How a trace ended.
@@ -228,6 +233,21 @@ pub fn trace<F: IndexField>(
     direction: DVec3,
     params: &TraceParams,
 ) -> Result<TraceResult, TraceError> {
+    trace_impl(field, origin, direction, params, |_, _| None)
+}
+
+/// [`trace`] with a skip oracle: before each step, `skip(x, d̂)` may return
+/// `(length, bound)`: the ray then moves `length` straight along `d̂`
+/// (`T` unchanged, optical path by the midpoint index), and `bound` (the
+/// deflection that straight move may have missed) is added to
+/// [`TraceStats::skip_bound`].
+pub(crate) fn trace_impl<F: IndexField>(
+    field: &F,
+    origin: DVec3,
+    direction: DVec3,
+    params: &TraceParams,
+    mut skip: impl FnMut(DVec3, DVec3) -> Option<(f64, f64)>,
+) -> Result<TraceResult, TraceError> {
     if !(origin.is_finite() && direction.is_finite()) || direction == DVec3::ZERO {
         return Err(TraceError::InvalidRay);
     }
@@ -265,6 +285,27 @@ pub fn trace<F: IndexField>(
         if travelled >= params.max_length {
             exit = Exit::MaxLength;
             break;
+        }
+        if let Some((len, bound)) = skip(y.x, y.t.normalize()) {
+            let d = y.t.normalize();
+            // A skip that would leave the bounds stops on their surface.
+            let inside = bounds.contains(y.x + len * d);
+            let len = if inside { len } else { bounds.clip(y.x, d).map_or(0.0, |(_, t1)| t1) };
+            let (n_mid, _) = ev.n(y.x + 0.5 * len * d)?;
+            let x = y.x + len * d;
+            let x = if inside { x } else { x.clamp(bounds.min, bounds.max) };
+            // Straight across a smooth region: T keeps its direction and
+            // |T| = n where the ray lands.
+            let (n_end, _) = ev.n(x)?;
+            y = State { x, t: n_end * d, opl: y.opl + n_mid * len };
+            travelled += len;
+            stats.steps += 1;
+            stats.skipped += 1;
+            stats.skip_bound += bound;
+            if !inside {
+                break;
+            }
+            continue;
         }
         let (next, used, err) = match params.method {
             Method::Adaptive => adaptive_step(&mut ev, &y, &mut h, params, &mut stats)?,

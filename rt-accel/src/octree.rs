@@ -1,0 +1,253 @@
+//! A min/max octree over a gridded scalar field, for skipping the regions
+//! of a refractive-index volume where rays go (almost) straight.
+//!
+//! The grid's samples sit at integer *sample coordinates*; the trilinear
+//! interpolant on the dual cell `[i, i+1]×[j, j+1]×[k, k+1]` is bounded by
+//! its eight corner samples, and its gradient component along axis `a` by
+//! the largest corner difference along `a` divided by the spacing. Leaves
+//! are bricks of [`BRICK`]³ dual cells; each node stores, over everything it
+//! covers, `min n`, `max n` and `max |∇n|` (the Euclidean norm of the
+//! per-axis bounds). Levels are dense arrays, finest first, over a
+//! power-of-two cube of bricks.
+//!
+//! A ray may cross a node in one straight step when
+//! `max|∇n| · diagonal < tolerance`: the deflection it skips is at most
+//! `∫|∇⊥n|/n ds ≤ max|∇n| · diagonal / min n`, so `tolerance` is the
+//! deflection (radians, for `n ≈ 1`) allowed per skipped node.
+
+#[cfg(feature = "alloc")]
+use alloc::vec::Vec;
+
+/// Dual cells per brick edge.
+pub const BRICK: usize = 4;
+
+/// Statistics of one octree node.
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+pub struct OctNode {
+    /// Smallest value covered.
+    pub min: f32,
+    /// Largest value covered.
+    pub max: f32,
+    /// Bound on `|∇|` of the trilinear interpolant (per world unit).
+    pub grad_max: f32,
+}
+
+#[cfg(feature = "alloc")]
+impl OctNode {
+    const EMPTY: Self = Self { min: f32::INFINITY, max: f32::NEG_INFINITY, grad_max: 0.0 };
+
+    fn merge(self, o: Self) -> Self {
+        Self {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+            grad_max: self.grad_max.max(o.grad_max),
+        }
+    }
+}
+
+/// A node the ray may cross straight: its box in sample coordinates and
+/// its statistics.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SmoothNode {
+    /// Lower corner (sample coordinates).
+    pub lo: [f64; 3],
+    /// Upper corner.
+    pub hi: [f64; 3],
+    /// Its statistics.
+    pub stats: OctNode,
+}
+
+/// The octree (see the module docs).
+#[derive(Clone, Debug, PartialEq)]
+#[cfg(feature = "alloc")]
+pub struct Octree {
+    /// Bricks per edge at the finest level (a power of two).
+    side: usize,
+    /// Dual cells per axis.
+    cells: [usize; 3],
+    /// World size of one dual cell.
+    spacing: [f64; 3],
+    /// Levels, finest first; level `l` has `(side >> l)³` nodes, x fastest.
+    levels: Vec<Vec<OctNode>>,
+}
+
+/// Why an octree could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OctreeError {
+    /// Fewer than 2 samples on an axis, or `samples.len()` is not the product
+    /// of `dims`.
+    BadDims,
+    /// A sample is not finite or the spacing is not finite and positive.
+    NonFinite,
+}
+
+impl core::fmt::Display for OctreeError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::BadDims => "octree needs ≥ 2 samples per axis and matching data",
+            Self::NonFinite => "octree samples and spacing must be finite (spacing > 0)",
+        })
+    }
+}
+
+impl core::error::Error for OctreeError {}
+
+#[cfg(feature = "alloc")]
+impl Octree {
+    /// Builds the octree over `samples` (x fastest) of a `dims` grid with
+    /// the given spacing.
+    ///
+    /// # Errors
+    /// [`OctreeError`] for bad dimensions or non-finite input.
+    pub fn build(
+        dims: [usize; 3],
+        samples: &[f32],
+        spacing: [f64; 3],
+    ) -> Result<Self, OctreeError> {
+        if dims.iter().any(|&d| d < 2)
+            || dims[0].checked_mul(dims[1]).and_then(|v| v.checked_mul(dims[2]))
+                != Some(samples.len())
+        {
+            return Err(OctreeError::BadDims);
+        }
+        if !samples.iter().all(|v| v.is_finite())
+            || !spacing.iter().all(|h| h.is_finite() && *h > 0.0)
+        {
+            return Err(OctreeError::NonFinite);
+        }
+        let cells = [dims[0] - 1, dims[1] - 1, dims[2] - 1];
+        let bricks = cells.map(|c| c.div_ceil(BRICK));
+        let side = bricks.iter().copied().max().unwrap_or(1).next_power_of_two();
+        let at = |i: usize, j: usize, k: usize| samples[i + dims[0] * (j + dims[1] * k)];
+        // Finest level: one node per brick.
+        let mut finest = alloc::vec![OctNode::EMPTY; side * side * side];
+        for k in 0..cells[2] {
+            for j in 0..cells[1] {
+                for i in 0..cells[0] {
+                    let mut lo = f32::INFINITY;
+                    let mut hi = f32::NEG_INFINITY;
+                    let mut d = [0.0f32; 3];
+                    for c in 0..8 {
+                        let (di, dj, dk) = (c & 1, (c >> 1) & 1, (c >> 2) & 1);
+                        let v = at(i + di, j + dj, k + dk);
+                        lo = lo.min(v);
+                        hi = hi.max(v);
+                        // Differences along each axis between paired corners.
+                        if di == 0 {
+                            d[0] = d[0].max((at(i + 1, j + dj, k + dk) - v).abs());
+                        }
+                        if dj == 0 {
+                            d[1] = d[1].max((at(i + di, j + 1, k + dk) - v).abs());
+                        }
+                        if dk == 0 {
+                            d[2] = d[2].max((at(i + di, j + dj, k + 1) - v).abs());
+                        }
+                    }
+                    let g = (0..3).map(|a| (f64::from(d[a]) / spacing[a]).powi(2)).sum::<f64>();
+                    let node =
+                        OctNode { min: lo, max: hi, grad_max: (sqrt(g) * (1.0 + 1e-6)) as f32 };
+                    let b = (i / BRICK) + side * ((j / BRICK) + side * (k / BRICK));
+                    finest[b] = finest[b].merge(node);
+                }
+            }
+        }
+        let mut levels = alloc::vec![finest];
+        let mut s = side;
+        while s > 1 {
+            let prev = levels.last().expect("a level");
+            let n = s / 2;
+            let mut next = alloc::vec![OctNode::EMPTY; n * n * n];
+            for k in 0..s {
+                for j in 0..s {
+                    for i in 0..s {
+                        let p = (i / 2) + n * ((j / 2) + n * (k / 2));
+                        next[p] = next[p].merge(prev[i + s * (j + s * k)]);
+                    }
+                }
+            }
+            levels.push(next);
+            s = n;
+        }
+        Ok(Self { side, cells, spacing, levels })
+    }
+
+    /// Number of levels (finest is 0).
+    #[must_use]
+    pub fn levels(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// The root's statistics: the whole field's range and gradient bound.
+    #[must_use]
+    pub fn root(&self) -> OctNode {
+        self.levels.last().map_or(OctNode::EMPTY, |l| l[0])
+    }
+
+    /// The largest node containing the sample-coordinate point `p` that a
+    /// ray may cross straight (`grad_max · diagonal < tolerance`), or
+    /// `None` where even the brick holding `p` is not smooth enough (or `p`
+    /// lies outside the cells).
+    #[must_use]
+    pub fn smooth_node(&self, p: [f64; 3], tolerance: f64) -> Option<SmoothNode> {
+        if (0..3).any(|a| !(p[a] >= 0.0 && p[a] <= self.cells[a] as f64)) {
+            return None;
+        }
+        // Brick coordinates at the finest level.
+        let b = [0, 1, 2].map(|a| ((p[a] as usize).min(self.cells[a] - 1)) / BRICK);
+        for l in (0..self.levels.len()).rev() {
+            let s = self.side >> l;
+            let idx = [b[0] >> l, b[1] >> l, b[2] >> l];
+            let node = self.levels[l][idx[0] + s * (idx[1] + s * idx[2])];
+            let size = (BRICK << l) as f64;
+            let lo = idx.map(|v| v as f64 * size);
+            let hi = [0, 1, 2].map(|a| (lo[a] + size).min(self.cells[a] as f64));
+            let diag = sqrt((0..3).map(|a| ((hi[a] - lo[a]) * self.spacing[a]).powi(2)).sum());
+            if f64::from(node.grad_max) * diag < tolerance {
+                return Some(SmoothNode { lo, hi, stats: node });
+            }
+        }
+        None
+    }
+}
+
+#[cfg(feature = "alloc")]
+fn sqrt(x: f64) -> f64 {
+    // Newton's method seeded by the f32 root: enough for a bound, and
+    // keeps the module free of std/libm.
+    if x <= 0.0 {
+        return 0.0;
+    }
+    let mut r = f64::from(f32::from_bits((x as f32).to_bits() / 2 + 0x1fbd_1df5)).max(1e-300);
+    for _ in 0..6 {
+        r = 0.5 * (r + x / r);
+    }
+    r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stats_bound_a_linear_ramp_and_uniform_regions_are_smooth() {
+        // n = 1 + 0.01·x on 17³ samples, spacing 0.5 → |∇n| = 0.01.
+        let dims = [17, 17, 17];
+        let data: alloc::vec::Vec<f32> =
+            (0..17 * 17 * 17).map(|i| 1.0 + 0.01 * 0.5 * (i % 17) as f32).collect();
+        let t = Octree::build(dims, &data, [0.5; 3]).unwrap();
+        let r = t.root();
+        assert!((r.grad_max - 0.01).abs() < 1e-5, "{}", r.grad_max);
+        assert_eq!((r.min, r.max), (1.0, 1.0 + 0.01 * 0.5 * 16.0));
+        // The whole volume (diagonal 8·√3) is smooth for a loose tolerance…
+        let n = t.smooth_node([3.0, 3.0, 3.0], 0.2).unwrap();
+        assert_eq!((n.lo, n.hi), ([0.0; 3], [16.0; 3]));
+        // …only a brick for a tighter one, nothing for a tight one.
+        let n = t.smooth_node([3.0, 3.0, 3.0], 0.04).unwrap();
+        assert_eq!(n.hi, [4.0; 3]);
+        assert!(t.smooth_node([3.0, 3.0, 3.0], 1e-3).is_none());
+        assert!(t.smooth_node([-1.0, 3.0, 3.0], 1.0).is_none());
+        assert_eq!(Octree::build([1, 2, 2], &[0.0; 4], [1.0; 3]), Err(OctreeError::BadDims));
+        assert_eq!(Octree::build([2, 2, 2], &[f32::NAN; 8], [1.0; 3]), Err(OctreeError::NonFinite));
+    }
+}
