@@ -4,6 +4,7 @@
 //! ```text
 //! cargo run --release -p rt-benches --bin rt-report -- traversal [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- grin [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- octree [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- all [--quick]
 //! ```
 // A std-only tool crate: the no_std import lints guard the libraries.
@@ -12,6 +13,7 @@
 #[cfg(feature = "embree3")]
 mod embree3;
 mod grin;
+mod octree;
 mod timing;
 #[cfg(feature = "tinybvh")]
 mod tinybvh;
@@ -33,8 +35,11 @@ fn main() -> ExitCode {
     let quick = args.iter().any(|a| a == "--quick");
     let areas: Vec<&str> =
         args.iter().filter(|a| !a.starts_with("--")).map(String::as_str).collect();
-    let areas =
-        if areas.is_empty() || areas == ["all"] { vec!["traversal", "grin"] } else { areas };
+    let areas = if areas.is_empty() || areas == ["all"] {
+        vec!["traversal", "grin", "octree"]
+    } else {
+        areas
+    };
     let dir = out_dir();
     if let Err(e) = std::fs::create_dir_all(&dir) {
         eprintln!("cannot create {}: {e}", dir.display());
@@ -44,7 +49,8 @@ fn main() -> ExitCode {
         let result = match area {
             "traversal" => traversal::run(&dir, quick),
             "grin" => grin::run(&dir, quick),
-            other => Err(format!("unknown area `{other}` (known: traversal, grin, all)")),
+            "octree" => octree::run(&dir, quick),
+            other => Err(format!("unknown area `{other}` (known: traversal, grin, octree, all)")),
         };
         if let Err(e) = result {
             eprintln!("rt-report {area}: {e}");

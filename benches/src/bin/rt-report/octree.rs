@@ -1,0 +1,138 @@
+//! Octree skipping against uniform stepping on a sparse and a dense
+//! 128³ field: field evaluations, time, and the deflection error the
+//! skipping introduces (against the same integrator without skipping).
+
+use std::{fmt::Write as _, path::Path};
+
+use glam::DVec3;
+use rt_volume::{
+    Grid, GridField, Interp, Method, TraceParams, TraceResult, build_octree, trace, trace_skipping,
+};
+
+use crate::timing::time;
+
+const N: usize = 128;
+
+/// Ambient 1 plus Gaussian bumps `(centre, amplitude, σ)` on the unit cube.
+fn field(bumps: &[(DVec3, f64, f64)]) -> GridField {
+    let h = 1.0 / N as f64;
+    let origin = DVec3::splat(0.5 * h);
+    let mut data = Vec::with_capacity(N * N * N);
+    for k in 0..N {
+        for j in 0..N {
+            for i in 0..N {
+                let p = origin + DVec3::new(i as f64, j as f64, k as f64) * h;
+                let v: f64 = 1.0
+                    + bumps
+                        .iter()
+                        .map(|(c, a, s)| a * (-(p - *c).length_squared() / (2.0 * s * s)).exp())
+                        .sum::<f64>();
+                data.push(v as f32);
+            }
+        }
+    }
+    GridField::new(
+        Grid::new([N; 3], origin, DVec3::splat(h), data).expect("grid"),
+        Interp::Trilinear,
+        1.0,
+    )
+    .expect("field")
+}
+
+/// Four compact bumps (σ = 0.02): their gradients fill well under 10 % of
+/// the volume.
+fn sparse() -> GridField {
+    field(&[
+        (DVec3::new(0.3, 0.3, 0.3), 3e-3, 0.02),
+        (DVec3::new(0.7, 0.35, 0.6), 2e-3, 0.02),
+        (DVec3::new(0.4, 0.7, 0.5), 3e-3, 0.02),
+        (DVec3::new(0.65, 0.7, 0.25), 1e-3, 0.02),
+    ])
+}
+
+/// Forty broad bumps (σ = 0.08) that overlap everywhere.
+fn dense() -> GridField {
+    let bumps: Vec<_> = (0..40)
+        .map(|i| {
+            let t = f64::from(i);
+            let c = DVec3::new(
+                (t * 0.618).fract(),
+                (t * 0.382 + 0.1).fract(),
+                (t * 0.7548 + 0.3).fract(),
+            );
+            (c, 1e-3, 0.08)
+        })
+        .collect();
+    field(&bumps)
+}
+
+/// A 32 × 32 beam of parallel rays along z through the unit cube.
+fn beam() -> Vec<(DVec3, DVec3)> {
+    (0..32 * 32)
+        .map(|i| {
+            let (x, y) = ((i % 32) as f64 + 0.5, (i / 32) as f64 + 0.5);
+            (DVec3::new(x / 32.0, y / 32.0, -0.1), DVec3::Z)
+        })
+        .collect()
+}
+
+pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
+    let params = TraceParams::fixed(Method::Rk4, 0.5 / N as f64);
+    let rays = beam();
+    let rays = if quick { &rays[..256] } else { &rays[..] };
+    let mut csv = String::from("field,method,field_evals,seconds,max_deflection_error,tolerance\n");
+    let mut md = String::from(
+        "| field | method | tolerance | field evals | seconds | max deflection error | ≤ tolerance | evals vs uniform |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut verdict = String::new();
+    for (name, f) in [("sparse", sparse()), ("dense", dense())] {
+        let tree = build_octree(&f).map_err(|e| e.to_string())?;
+        let go = |skip: Option<f64>| -> Result<(f64, Vec<TraceResult>), String> {
+            let (secs, out) = time(|| {
+                rays.iter()
+                    .map(|(o, d)| match skip {
+                        None => trace(&f, *o, *d, &params),
+                        Some(tol) => trace_skipping(&f, &tree, *o, *d, &params, tol),
+                    })
+                    .collect::<Result<Vec<_>, _>>()
+            });
+            Ok((secs, out.map_err(|e| e.to_string())?))
+        };
+        let (useconds, uniform) = go(None)?;
+        let uevals: u64 = uniform.iter().map(|r| u64::from(r.stats.field_evals)).sum();
+        writeln!(csv, "{name},uniform,{uevals},{useconds:.4},0,0").unwrap();
+        writeln!(md, "| {name} | uniform | — | {uevals} | {useconds:.3} | 0 | — | 1 |").unwrap();
+        for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7] {
+            let (secs, out) = go(Some(tol))?;
+            let evals: u64 = out.iter().map(|r| u64::from(r.stats.field_evals)).sum();
+            let err = out
+                .iter()
+                .zip(&uniform)
+                .map(|(a, b)| (a.direction - b.direction).length())
+                .fold(0.0f64, f64::max);
+            writeln!(csv, "{name},octree,{evals},{secs:.4},{err:e},{tol:e}").unwrap();
+            let ratio = evals as f64 / uevals as f64;
+            writeln!(
+                md,
+                "| {name} | octree | {tol:.0e} | {evals} | {secs:.3} | {err:.2e} | {} | {ratio:.3} |",
+                if err <= tol { "yes" } else { "no" }
+            )
+            .unwrap();
+            if name == "sparse" && err <= tol && ratio <= 0.2 && verdict.is_empty() {
+                verdict = format!(
+                    "sparse: octree at tolerance {tol:.0e} uses {ratio:.3}× the field evaluations of uniform stepping with max deflection error {err:.1e} ≤ tolerance → met (target ≤ 1/5)"
+                );
+            }
+        }
+    }
+    if verdict.is_empty() {
+        verdict = "sparse: no tolerance reached ≤ 1/5 of uniform's evaluations within tolerance → NOT met".into();
+    }
+    std::fs::write(dir.join("octree.csv"), &csv).map_err(|e| e.to_string())?;
+    println!(
+        "## octree (RK4, step = half a cell, {} rays of a parallel beam, 128³ grid)\n\n{md}\n- {verdict}\n\nwrote {}",
+        rays.len(),
+        dir.join("octree.csv").display()
+    );
+    Ok(())
+}
