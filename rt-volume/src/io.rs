@@ -1,5 +1,6 @@
 //! Readers for gridded data (feature `io`): raw samples with a JSON header
-//! (the project's sidecar format) and NRRD (the original tool's format).
+//! (the project's sidecar format), NRRD (the original tool's format) and
+//! VTK image data (through `vtkio`).
 //! Every malformed, truncated or oversized input is an `Err` naming the
 //! problem; samples that are NaN or infinite are rejected.
 
@@ -336,8 +337,62 @@ pub fn parse_raw_json(v: &serde_json::Value, payload: &[u8]) -> Result<Grid, Rea
     Ok(Grid::new(dims, origin, spacing, data)?)
 }
 
+/// Reads VTK image data (legacy `STRUCTURED_POINTS` or XML `ImageData`,
+/// `.vtk`/`.vti`) with the `vtkio` crate: the first point-data array
+/// (first component) becomes the samples, point `(0,0,0)` at `origin`
+/// (taken as sample centres, the crates' cell-centred convention).
+///
+/// # Errors
+/// [`ReadError`] naming the problem: unreadable or malformed files, other
+/// data set types, compressed XML payloads, no point data.
+pub fn read_vtk(path: &Path) -> Result<Grid, ReadError> {
+    use vtkio::model::{Attribute, DataSet, Extent};
+    let vtk = vtkio::Vtk::import(path).map_err(|e| match e {
+        vtkio::Error::IO(io) => ReadError::Io { path: path.to_path_buf(), message: io.to_string() },
+        other => ReadError::Malformed(format!("VTK: {other}")),
+    })?;
+    let DataSet::ImageData { extent, origin, spacing, pieces, .. } = vtk.data else {
+        return Err(ReadError::Unsupported(
+            "VTK data set other than image data / structured points".into(),
+        ));
+    };
+    let dims = match extent {
+        Extent::Dims(d) => d.map(|v| v as usize),
+        Extent::Ranges(r) => {
+            let len = |x: &core::ops::RangeInclusive<i32>| {
+                usize::try_from(i64::from(*x.end()) - i64::from(*x.start()) + 1).unwrap_or(0)
+            };
+            [len(&r[0]), len(&r[1]), len(&r[2])]
+        }
+    };
+    let piece = pieces
+        .into_iter()
+        .next()
+        .ok_or_else(|| ReadError::Malformed("VTK image data without pieces".into()))?
+        .into_loaded_piece_data(path.parent())
+        .map_err(|e| ReadError::Malformed(format!("VTK piece: {e}")))?;
+    let (data, components) = piece
+        .data
+        .point
+        .into_iter()
+        .find_map(|a| match a {
+            Attribute::DataArray(d) => Some((d.data, d.elem.num_comp() as usize)),
+            Attribute::Field { data_array, .. } => {
+                data_array.into_iter().next().map(|f| (f.data, f.elem as usize))
+            }
+        })
+        .ok_or_else(|| ReadError::Malformed("VTK image data without point data".into()))?;
+    let values: Vec<f32> =
+        data.cast_into::<f32>().ok_or_else(|| ReadError::Unsupported("VTK sample type".into()))?;
+    let values =
+        if components > 1 { values.iter().step_by(components).copied().collect() } else { values };
+    let f = |a: [f32; 3]| DVec3::new(f64::from(a[0]), f64::from(a[1]), f64::from(a[2]));
+    Ok(Grid::new(dims, f(origin), f(spacing), values)?)
+}
+
 /// Reads a grid by extension: `.nrrd`/`.nhdr` as NRRD, `.json` as a raw
-/// header; a `.raw` file is read through the `.json` beside it.
+/// header (a `.raw` file is read through the `.json` beside it),
+/// `.vtk`/`.vti` as VTK image data.
 ///
 /// # Errors
 /// [`ReadError`] naming the problem.
@@ -346,6 +401,7 @@ pub fn read_grid(path: &Path) -> Result<Grid, ReadError> {
         Some("nrrd" | "nhdr") => read_nrrd(path),
         Some("json") => read_raw_json(path),
         Some("raw") => read_raw_json(&path.with_extension("json")),
+        Some("vtk" | "vti") => read_vtk(path),
         other => Err(ReadError::Unsupported(format!("file extension {other:?}"))),
     }
 }

@@ -87,7 +87,7 @@ fn malformed_nrrd_is_an_error() {
 #[test]
 fn missing_files_and_bad_json_are_errors() {
     assert!(matches!(read_grid(Path::new("/nonexistent/x.nrrd")), Err(ReadError::Io { .. })));
-    assert!(matches!(read_grid(Path::new("x.vtk")), Err(ReadError::Unsupported(_))));
+    assert!(matches!(read_grid(Path::new("x.vtu")), Err(ReadError::Unsupported(_))));
     let v: serde_json::Value =
         serde_json::json!({"dims": [2, 2], "spacing": [1, 1, 1], "origin": [0, 0, 0]});
     assert!(rt_volume::io::parse_raw_json(&v, &[0; 32]).is_err());
@@ -100,4 +100,54 @@ fn missing_files_and_bad_json_are_errors() {
     ));
     let v: serde_json::Value = serde_json::json!({"dims": [2, 2, 2], "dtype": "complex64", "spacing": [1, 1, 1], "origin": [0, 0, 0]});
     assert!(matches!(rt_volume::io::parse_raw_json(&v, &[0; 32]), Err(ReadError::Unsupported(_))));
+}
+
+/// Legacy VTK structured points: geometry and samples as written; other data
+/// sets and garbage are errors.
+#[test]
+fn vtk_structured_points() {
+    let dir = std::env::temp_dir().join(format!("rt-volume-vtk-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = dir.join("sp.vtk");
+    let values: Vec<String> = (0..24).map(|i| format!("{}", 1.0 + 0.01 * f64::from(i))).collect();
+    std::fs::write(
+        &good,
+        format!(
+            "# vtk DataFile Version 3.0\nrt test\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3 2\nORIGIN 0.5 -1 2\nSPACING 0.25 0.5 1\nPOINT_DATA 24\nSCALARS n float 1\nLOOKUP_TABLE default\n{}\n",
+            values.join(" ")
+        ),
+    )
+    .unwrap();
+    let g = read_grid(&good).expect("structured points");
+    assert_eq!(g.dims(), [4, 3, 2]);
+    assert_eq!(g.origin(), DVec3::new(0.5, -1.0, 2.0));
+    assert_eq!(g.spacing(), DVec3::new(0.25, 0.5, 1.0));
+    assert_eq!(g.data()[23], 1.23);
+    let bad = dir.join("bad.vtk");
+    std::fs::write(
+        &bad,
+        "# vtk DataFile Version 3.0\nx\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3\n",
+    )
+    .unwrap();
+    assert!(matches!(read_grid(&bad), Err(ReadError::Malformed(_))), "{:?}", read_grid(&bad));
+    let poly = dir.join("poly.vtk");
+    std::fs::write(
+        &poly,
+        "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 1 float\n0 0 0\n",
+    )
+    .unwrap();
+    assert!(matches!(read_grid(&poly), Err(ReadError::Unsupported(_))), "{:?}", read_grid(&poly));
+    let nan = dir.join("nan.vtk");
+    let mut v = values.clone();
+    v[5] = "nan".into();
+    std::fs::write(
+        &nan,
+        format!(
+            "# vtk DataFile Version 3.0\nrt test\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3 2\nORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 24\nSCALARS n float 1\nLOOKUP_TABLE default\n{}\n",
+            v.join(" ")
+        ),
+    )
+    .unwrap();
+    assert!(read_grid(&nan).is_err());
+    std::fs::remove_dir_all(&dir).ok();
 }
