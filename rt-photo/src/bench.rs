@@ -1,0 +1,231 @@
+//! The optical bench: a collimated beam through a field onto a film.
+
+use alloc::vec::Vec;
+use core::fmt;
+
+use glam::DVec3;
+use rt_core::sampling::{rng_for, uniform};
+use rt_volume::{IndexField, TraceError, TraceParams, trace};
+
+use crate::{Cutoff, Film};
+
+/// What the film records.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Mode {
+    /// Schlieren or shadowgraph: the cutoff's transmission.
+    Schlieren(Cutoff),
+    /// Interferometry: `I = (1 + cos(φ + 2π x/Λ))/2` with
+    /// `φ = (2π/λ)·∫ (n − n_ref) ds`.
+    Interferometry {
+        /// Wavelength (length units of the scene).
+        lambda: f64,
+        /// Reference index.
+        n_ref: f64,
+        /// Fringe spacing `Λ` on the film (`None`: infinite fringe).
+        fringe_spacing: Option<f64>,
+    },
+}
+
+/// How photons are weighted by the cutoff.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Weighting {
+    /// Each photon deposits its transmission.
+    Weight,
+    /// Russian roulette: each photon passes with probability equal to its
+    /// (grey) transmission and deposits 1, or is absorbed; same expectation.
+    Roulette,
+}
+
+/// Why a render could not run.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BenchError {
+    /// A parameter is out of range (named).
+    BadParameter(&'static str),
+    /// Tracing a photon failed.
+    Trace(TraceError),
+}
+
+impl fmt::Display for BenchError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BadParameter(p) => write!(f, "bad parameter: {p}"),
+            Self::Trace(e) => write!(f, "trace: {e}"),
+        }
+    }
+}
+
+impl core::error::Error for BenchError {}
+
+/// A collimated beam, the optics behind the test section, and the film.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bench {
+    /// Centre of the beam's emission plane (upstream of the field).
+    pub center: DVec3,
+    /// Beam direction (unit).
+    pub direction: DVec3,
+    /// Film/image axis u (unit, ⟂ direction); v = direction × u.
+    pub u: DVec3,
+    /// Beam (and film) width along u.
+    pub width: f64,
+    /// Beam height along v.
+    pub height: f64,
+    /// Distance from the exit point to the film along the ray
+    /// (shadowgraph; 0 images the test section).
+    pub film_distance: f64,
+    /// What is recorded.
+    pub mode: Mode,
+    /// Cutoff weighting.
+    pub weighting: Weighting,
+    /// Photons per pixel per pass: `k × k` strata.
+    pub strata: u32,
+    /// Integrator settings.
+    pub params: TraceParams,
+}
+
+/// One traced photon: film coordinates (pixels), weight, deflection.
+type Landing = (f64, f64, [f32; 3], (f64, f64));
+
+impl Bench {
+    fn v(&self) -> DVec3 {
+        self.direction.cross(self.u)
+    }
+
+    fn validate(&self, film: &Film) -> Result<(), BenchError> {
+        let bad = BenchError::BadParameter;
+        let finite3 = |v: DVec3| v.is_finite();
+        if !(finite3(self.center) && finite3(self.direction) && finite3(self.u)) {
+            return Err(bad("beam centre/direction/u not finite"));
+        }
+        if (self.direction.length() - 1.0).abs() > 1e-9
+            || (self.u.length() - 1.0).abs() > 1e-9
+            || self.u.dot(self.direction).abs() > 1e-9
+        {
+            return Err(bad("direction and u must be orthonormal"));
+        }
+        if !(self.width.is_finite()
+            && self.width > 0.0
+            && self.height.is_finite()
+            && self.height > 0.0)
+        {
+            return Err(bad("beam width/height"));
+        }
+        if !(self.film_distance.is_finite()) {
+            return Err(bad("film distance"));
+        }
+        if self.strata == 0 || self.strata > 64 {
+            return Err(bad("strata must be 1..=64 (photons per pixel = strata²)"));
+        }
+        if film.width() == 0 || film.height() == 0 {
+            return Err(bad("film is empty"));
+        }
+        match &self.mode {
+            Mode::Schlieren(c) => c.validate().map_err(bad),
+            Mode::Interferometry { lambda, n_ref, fringe_spacing } => {
+                if !(lambda.is_finite() && *lambda > 0.0) {
+                    Err(bad("wavelength must be finite and > 0"))
+                } else if !(n_ref.is_finite() && *n_ref > 0.0) {
+                    Err(bad("reference index"))
+                } else if fringe_spacing.is_some_and(|s| !(s.is_finite() && s > 0.0)) {
+                    Err(bad("fringe spacing"))
+                } else {
+                    Ok(())
+                }
+            }
+        }
+    }
+
+    /// Traces the photons of film row `row` for pass `pass`.
+    fn row<F: IndexField>(
+        &self,
+        field: &F,
+        film: &Film,
+        row: usize,
+        pass: u64,
+        seed: u64,
+    ) -> Result<Vec<Landing>, BenchError> {
+        let (w, h) = (film.width(), film.height());
+        let k = self.strata as usize;
+        let mut rng = rng_for(seed ^ pass.wrapping_mul(0x9e37_79b9_7f4a_7c15), row as u64);
+        let mut out = Vec::with_capacity(w * k * k);
+        let v = self.v();
+        for i in 0..w {
+            for s in 0..k * k {
+                // Stratified and jittered inside the pixel's footprint.
+                let (sx, sy) = ((s % k) as f64, (s / k) as f64);
+                let px = i as f64 + (sx + uniform(&mut rng) as f64) / k as f64;
+                let py = row as f64 + (sy + uniform(&mut rng) as f64) / k as f64;
+                let a = (px / w as f64 - 0.5) * self.width;
+                let b = (0.5 - py / h as f64) * self.height;
+                let o = self.center + a * self.u + b * v;
+                let r = trace(field, o, self.direction, &self.params).map_err(BenchError::Trace)?;
+                let e = r.direction;
+                let (eu, ev) = (e.dot(self.u), e.dot(v));
+                // Exit point carried L further along the ray, on the film plane.
+                let along = e.dot(self.direction).max(1e-12);
+                let p = r.position + (self.film_distance / along) * e;
+                let fa = (p - self.center).dot(self.u);
+                let fb = (p - self.center).dot(v);
+                let fx = (fa / self.width + 0.5) * w as f64;
+                let fy = (0.5 - fb / self.height) * h as f64;
+                let weight = match &self.mode {
+                    Mode::Schlieren(c) => {
+                        let t = c.transmit(eu, ev);
+                        match self.weighting {
+                            Weighting::Weight => t,
+                            Weighting::Roulette => {
+                                let g = (t[0] + t[1] + t[2]) / 3.0;
+                                if uniform(&mut rng) < g { [1.0; 3] } else { [0.0; 3] }
+                            }
+                        }
+                    }
+                    Mode::Interferometry { lambda, n_ref, fringe_spacing } => {
+                        let straight = (r.position - o).dot(self.direction);
+                        let phi =
+                            core::f64::consts::TAU / lambda * (r.optical_path - n_ref * straight);
+                        let carrier =
+                            fringe_spacing.map_or(0.0, |s| core::f64::consts::TAU * fa / s);
+                        [(0.5 * (1.0 + (phi + carrier).cos())) as f32; 3]
+                    }
+                };
+                out.push((fx, fy, weight, (eu, ev)));
+            }
+        }
+        Ok(out)
+    }
+
+    /// Adds one pass of `strata²` photons per pixel to `film` (progressive:
+    /// call again with the next `pass` to refine). Photons of each row use
+    /// their own random stream from `(seed, pass, row)`, and are splatted in
+    /// row order, so the image is bit-identical at any thread count.
+    ///
+    /// # Errors
+    /// [`BenchError`] for bad parameters or a failing trace; the film is
+    /// unchanged then.
+    pub fn render<F: IndexField + Sync>(
+        &self,
+        field: &F,
+        film: &mut Film,
+        pass: u64,
+        seed: u64,
+    ) -> Result<(), BenchError> {
+        self.validate(film)?;
+        let rows: Vec<usize> = (0..film.height()).collect();
+        #[cfg(feature = "parallel")]
+        let traced: Vec<Result<Vec<Landing>, BenchError>> = {
+            use rayon::prelude::*;
+            rows.par_iter().map(|&r| self.row(field, film, r, pass, seed)).collect()
+        };
+        #[cfg(not(feature = "parallel"))]
+        let traced: Vec<Result<Vec<Landing>, BenchError>> =
+            rows.iter().map(|&r| self.row(field, film, r, pass, seed)).collect();
+        let traced: Vec<Vec<Landing>> = traced.into_iter().collect::<Result<_, _>>()?;
+        for row in traced {
+            for (x, y, w, e) in row {
+                film.emitted += 1;
+                film.splat(x, y, w, e);
+            }
+        }
+        film.per_pixel += f64::from(self.strata * self.strata);
+        Ok(())
+    }
+}
