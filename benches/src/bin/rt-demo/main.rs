@@ -4,13 +4,23 @@
 //! cargo run --release -p rt-benches --bin rt-demo -- [OUT_DIR]   (default: out/)
 //! ```
 //!
-//! Today: `surface.png`, a ray-traced scientific surface scene: a terrain
-//! mesh coloured by its height through viridis (the scalar is interpolated
-//! across each triangle, then mapped), sphere glyphs coloured with the
-//! cool-to-warm map, and a streamline tube of capsules, under a directional
-//! light with hard shadows. 8-bit sRGB RGBA.
+//! Writes, 8-bit sRGB PNGs:
+//! - `surface.png`: a ray-traced scientific surface scene: a terrain mesh
+//!   coloured by its height through viridis (the scalar is interpolated
+//!   across each triangle, then mapped), sphere glyphs coloured with the
+//!   cool-to-warm map, and a streamline tube of capsules, under a
+//!   directional light with hard shadows.
+//! - From the built-in blast wave (`benches/data/`, a real PyClaw Euler
+//!   solution, density → index by Gladstone–Dale), photons traced through
+//!   the volume along z: `schlieren-knife.png` (vertical knife edge,
+//!   background mid-grey), `shadowgraph.png` (film 2 m behind, background
+//!   mid-grey), `interferogram.png` (10.6 µm CO₂ laser, finite fringes) and
+//!   `schlieren-color.png` (hue-wheel colour filter: hue = direction of
+//!   deflection, saturation = its size).
 // A std-only tool crate: the no_std import lints guard the libraries.
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
+
+mod schlieren;
 
 use std::{path::PathBuf, process::ExitCode, time::Instant};
 
@@ -151,6 +161,7 @@ fn run(out: &std::path::Path) -> Result<(), String> {
             });
         }
     });
+    let rendered = t1.elapsed();
     let path = out.join("surface.png");
     write_png(&frame, &path)?;
     println!(
@@ -160,7 +171,7 @@ fn run(out: &std::path::Path) -> Result<(), String> {
         world.spheres.len(),
         world.scene.capsules.prim_count(),
         built.as_secs_f64() * 1e3,
-        t1.elapsed().as_secs_f64() * 1e3,
+        rendered.as_secs_f64() * 1e3,
     );
-    Ok(())
+    schlieren::render_all(out)
 }
