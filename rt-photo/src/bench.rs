@@ -5,7 +5,7 @@ use core::fmt;
 
 use glam::DVec3;
 use rt_core::sampling::{rng_for, uniform};
-use rt_volume::{IndexField, TraceError, TraceParams, trace};
+use rt_volume::{IndexField, TraceError, TraceParams, TraceResult, trace};
 
 use crate::{Cutoff, Film};
 
@@ -135,9 +135,9 @@ impl Bench {
     }
 
     /// Traces the photons of film row `row` for pass `pass`.
-    fn row<F: IndexField>(
+    fn row(
         &self,
-        field: &F,
+        tracer: &(impl Fn(DVec3, DVec3) -> Result<TraceResult, TraceError> + Sync),
         film: &Film,
         row: usize,
         pass: u64,
@@ -157,7 +157,7 @@ impl Bench {
                 let a = (px / w as f64 - 0.5) * self.width;
                 let b = (0.5 - py / h as f64) * self.height;
                 let o = self.center + a * self.u + b * v;
-                let r = trace(field, o, self.direction, &self.params).map_err(BenchError::Trace)?;
+                let r = tracer(o, self.direction).map_err(BenchError::Trace)?;
                 let e = r.direction;
                 let (eu, ev) = (e.dot(self.u), e.dot(v));
                 // Exit point carried L further along the ray, on the film plane.
@@ -208,16 +208,32 @@ impl Bench {
         pass: u64,
         seed: u64,
     ) -> Result<(), BenchError> {
+        self.render_with(&|o, d| trace(field, o, d, &self.params), film, pass, seed)
+    }
+
+    /// [`Bench::render`] with any tracer `(origin, direction) → result`,
+    /// e.g. octree skipping over a gridded field:
+    /// `|o, d| rt_volume::trace_skipping(&grid, &tree, o, d, &params, tol)`.
+    ///
+    /// # Errors
+    /// As [`Bench::render`].
+    pub fn render_with(
+        &self,
+        tracer: &(impl Fn(DVec3, DVec3) -> Result<TraceResult, TraceError> + Sync),
+        film: &mut Film,
+        pass: u64,
+        seed: u64,
+    ) -> Result<(), BenchError> {
         self.validate(film)?;
         let rows: Vec<usize> = (0..film.height()).collect();
         #[cfg(feature = "parallel")]
         let traced: Vec<Result<Vec<Landing>, BenchError>> = {
             use rayon::prelude::*;
-            rows.par_iter().map(|&r| self.row(field, film, r, pass, seed)).collect()
+            rows.par_iter().map(|&r| self.row(tracer, film, r, pass, seed)).collect()
         };
         #[cfg(not(feature = "parallel"))]
         let traced: Vec<Result<Vec<Landing>, BenchError>> =
-            rows.iter().map(|&r| self.row(field, film, r, pass, seed)).collect();
+            rows.iter().map(|&r| self.row(tracer, film, r, pass, seed)).collect();
         let traced: Vec<Vec<Landing>> = traced.into_iter().collect::<Result<_, _>>()?;
         for row in traced {
             for (x, y, w, e) in row {
