@@ -5,6 +5,7 @@
 //! cargo run --release -p rt-benches --bin rt-report -- traversal [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- grin [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- octree [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- schlieren [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- all [--quick]
 //! ```
 // A std-only tool crate: the no_std import lints guard the libraries.
@@ -14,6 +15,7 @@
 mod embree3;
 mod grin;
 mod octree;
+mod schlieren;
 mod timing;
 #[cfg(feature = "tinybvh")]
 mod tinybvh;
@@ -36,7 +38,7 @@ fn main() -> ExitCode {
     let areas: Vec<&str> =
         args.iter().filter(|a| !a.starts_with("--")).map(String::as_str).collect();
     let areas = if areas.is_empty() || areas == ["all"] {
-        vec!["traversal", "grin", "octree"]
+        vec!["traversal", "grin", "octree", "schlieren"]
     } else {
         areas
     };
@@ -50,7 +52,10 @@ fn main() -> ExitCode {
             "traversal" => traversal::run(&dir, quick),
             "grin" => grin::run(&dir, quick),
             "octree" => octree::run(&dir, quick),
-            other => Err(format!("unknown area `{other}` (known: traversal, grin, octree, all)")),
+            "schlieren" => schlieren::run(&dir, quick),
+            other => Err(format!(
+                "unknown area `{other}` (known: traversal, grin, octree, schlieren, all)"
+            )),
         };
         if let Err(e) = result {
             eprintln!("rt-report {area}: {e}");

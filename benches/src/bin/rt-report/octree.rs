@@ -41,7 +41,7 @@ fn field(bumps: &[(DVec3, f64, f64)]) -> GridField {
 
 /// Four compact bumps (σ = 0.02): their gradients fill well under 10 % of
 /// the volume.
-fn sparse() -> GridField {
+pub(crate) fn sparse() -> GridField {
     field(&[
         (DVec3::new(0.3, 0.3, 0.3), 3e-3, 0.02),
         (DVec3::new(0.7, 0.35, 0.6), 2e-3, 0.02),
