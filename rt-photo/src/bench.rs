@@ -4,8 +4,9 @@ use alloc::vec::Vec;
 use core::fmt;
 
 use glam::DVec3;
+use rt_core::ColorMap;
 use rt_core::sampling::{rng_for, uniform};
-use rt_volume::{IndexField, TraceError, TraceParams, TraceResult, trace};
+use rt_volume::{IndexField, TraceError, TraceParams, TraceResult, trace, trace_visiting};
 
 use crate::{Cutoff, Film};
 
@@ -137,7 +138,7 @@ impl Bench {
     /// Traces the photons of film row `row` for pass `pass`.
     fn row(
         &self,
-        tracer: &(impl Fn(DVec3, DVec3) -> Result<TraceResult, TraceError> + Sync),
+        tracer: &(impl Fn(DVec3, DVec3) -> Result<(TraceResult, [f32; 3]), TraceError> + Sync),
         film: &Film,
         row: usize,
         pass: u64,
@@ -157,7 +158,7 @@ impl Bench {
                 let a = (px / w as f64 - 0.5) * self.width;
                 let b = (0.5 - py / h as f64) * self.height;
                 let o = self.center + a * self.u + b * v;
-                let r = tracer(o, self.direction).map_err(BenchError::Trace)?;
+                let (r, colour) = tracer(o, self.direction).map_err(BenchError::Trace)?;
                 let e = r.direction;
                 let (eu, ev) = (e.dot(self.u), e.dot(v));
                 // Exit point carried L further along the ray, on the film plane.
@@ -187,6 +188,7 @@ impl Bench {
                         [(0.5 * (1.0 + (phi + carrier).cos())) as f32; 3]
                     }
                 };
+                let weight = [weight[0] * colour[0], weight[1] * colour[1], weight[2] * colour[2]];
                 out.push((fx, fy, weight, (eu, ev)));
             }
         }
@@ -220,6 +222,44 @@ impl Bench {
     pub fn render_with(
         &self,
         tracer: &(impl Fn(DVec3, DVec3) -> Result<TraceResult, TraceError> + Sync),
+        film: &mut Film,
+        pass: u64,
+        seed: u64,
+    ) -> Result<(), BenchError> {
+        self.render_colored_with(&|o, d| tracer(o, d).map(|r| (r, [1.0; 3])), film, pass, seed)
+    }
+
+    /// Multifield: each photon also carries the colour `map(s̄)` of a
+    /// second, scalar field, `s̄` its mean over the steps of the photon's
+    /// bent path inside the volume, multiplied into its cutoff weight.
+    /// Photons that miss the volume carry white.
+    ///
+    /// # Errors
+    /// As [`Bench::render`].
+    pub fn render_colored<F: IndexField + Sync>(
+        &self,
+        field: &F,
+        scalar: &(impl Fn(DVec3) -> f64 + Sync),
+        map: &ColorMap<'_>,
+        film: &mut Film,
+        pass: u64,
+        seed: u64,
+    ) -> Result<(), BenchError> {
+        let tracer = |o: DVec3, d: DVec3| {
+            let (mut sum, mut n) = (0.0, 0u32);
+            let r = trace_visiting(field, o, d, &self.params, |x| {
+                sum += scalar(x);
+                n += 1;
+            })?;
+            let c = if n > 0 { map.map((sum / f64::from(n)) as f32) } else { [1.0; 4] };
+            Ok((r, [c[0], c[1], c[2]]))
+        };
+        self.render_colored_with(&tracer, film, pass, seed)
+    }
+
+    fn render_colored_with(
+        &self,
+        tracer: &(impl Fn(DVec3, DVec3) -> Result<(TraceResult, [f32; 3]), TraceError> + Sync),
         film: &mut Film,
         pass: u64,
         seed: u64,

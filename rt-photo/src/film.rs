@@ -3,13 +3,30 @@
 use alloc::vec::Vec;
 
 /// The reconstruction filter.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Filter {
     /// Each photon lands in the one pixel it hits. With pixel-aligned
     /// stratified emission an undisturbed field gives exactly the background.
     Box,
     /// Bilinear tent of one pixel radius; weights sum to 1 per photon.
     Tent,
+    /// A wider tent, `radius` pixels (≥ 1), weights normalised per photon:
+    /// for few photons per pixel (see [`Filter::adaptive`]).
+    WideTent {
+        /// Radius in pixels.
+        radius: f64,
+    },
+}
+
+impl Filter {
+    /// The adaptive-radius choice for `photons_per_pixel`: a tent whose
+    /// footprint (≈ radius² pixels) gathers about 4 photons, never narrower
+    /// than one pixel.
+    #[must_use]
+    pub fn adaptive(photons_per_pixel: f64) -> Self {
+        let r = if photons_per_pixel > 0.0 { (4.0 / photons_per_pixel).sqrt() } else { 4.0 };
+        if r <= 1.0 { Self::Tent } else { Self::WideTent { radius: r.min(16.0) } }
+    }
 }
 
 /// Accumulated photon weight per pixel (RGB), the mean deflection per pixel
@@ -83,6 +100,42 @@ impl Film {
         };
         match self.filter {
             Filter::Box => add(x as usize, y as usize, 1.0),
+            Filter::WideTent { radius } => {
+                // Separable tent over the pixel centres within `radius`;
+                // normalised over the pixels on the film.
+                let r = radius.max(1.0);
+                let (i0, i1) =
+                    (((x - r - 0.5).ceil()).max(0.0), ((x + r - 0.5).floor()).min(wd - 1.0));
+                let (j0, j1) =
+                    (((y - r - 0.5).ceil()).max(0.0), ((y + r - 0.5).floor()).min(ht - 1.0));
+                let tent = |d: f64| (1.0 - d.abs() / r).max(0.0);
+                let mut total = 0.0;
+                let mut j = j0;
+                while j <= j1 {
+                    let mut i = i0;
+                    while i <= i1 {
+                        total += tent(i + 0.5 - x) * tent(j + 0.5 - y);
+                        i += 1.0;
+                    }
+                    j += 1.0;
+                }
+                if total > 0.0 {
+                    let mut j = j0;
+                    while j <= j1 {
+                        let mut i = i0;
+                        while i <= i1 {
+                            let k = tent(i + 0.5 - x) * tent(j + 0.5 - y) / total;
+                            if k > 0.0 {
+                                add(i as usize, j as usize, k);
+                            }
+                            i += 1.0;
+                        }
+                        j += 1.0;
+                    }
+                } else {
+                    add(x as usize, y as usize, 1.0);
+                }
+            }
             Filter::Tent => {
                 // Bilinear weights to the four nearest pixel centres; weights
                 // falling off the film are renormalised onto the rest, so

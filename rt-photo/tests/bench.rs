@@ -256,3 +256,54 @@ fn straight_line_limit() {
         assert!((7.0..14.0).contains(&ratio), "not linear in δ: {d:?}");
     }
 }
+
+/// Multifield: photons carry the colour of a second field averaged along
+/// their path; with a scalar equal to x, each image column shows the
+/// colour map at that x, times the cutoff's weight (here none: 1).
+#[test]
+fn photons_carry_the_colour_of_a_second_field() {
+    let f = Constant { n: 1.0, bounds: Bounds::new(DVec3::splat(-3.0), DVec3::splat(3.0)) };
+    let map = rt_core::ColorMap::viridis().with_range(-3.0, 3.0).unwrap();
+    let mut film = Film::new(24, 8, Filter::Box).unwrap();
+    let b = bench(Mode::Schlieren(Cutoff::None), 2);
+    b.render_colored(&f, &|x: DVec3| x.x, &map, &mut film, 0, 4).unwrap();
+    let img = film.normalized();
+    for j in 0..8 {
+        for i in 0..24 {
+            let (x, _) = centre(&film, i, j);
+            let want = map.map(x as f32);
+            let got = img[i + 24 * j];
+            for c in 0..3 {
+                // Jitter spreads each pixel's photons over 0.25 in x.
+                assert!((got[c] - want[c]).abs() < 0.03, "pixel {i},{j}: {got:?} vs {want:?}");
+            }
+        }
+    }
+    assert_eq!(film.lost, 0);
+}
+
+/// With one photon per pixel and Russian roulette (each photon deposits 0
+/// or 1), the adaptive wide tent cuts the image noise against a
+/// 16-photon weighted reference, while keeping every photon's weight.
+#[test]
+fn adaptive_radius_reduces_noise_at_few_photons() {
+    let f = GaussianBump::new(DVec3::ZERO, 1e-4, 1.0, 5.0);
+    let b1 = Bench { weighting: Weighting::Roulette, ..bench(knife(1500.0), 1) };
+    let mut reference = Film::new(64, 64, Filter::Tent).unwrap();
+    bench(knife(1500.0), 4).render(&f, &mut reference, 0, 1).unwrap();
+    let diff = |a: &Film| {
+        let (x, y) = (a.normalized(), reference.normalized());
+        (x.iter().zip(&y).map(|(p, q)| f64::from(p[0] - q[0]).powi(2)).sum::<f64>()
+            / x.len() as f64)
+            .sqrt()
+    };
+    let mut sharp = Film::new(64, 64, Filter::Box).unwrap();
+    b1.render(&f, &mut sharp, 0, 2).unwrap();
+    let wide_filter = Filter::adaptive(1.0);
+    assert!(matches!(wide_filter, Filter::WideTent { radius } if radius == 2.0));
+    let mut wide = Film::new(64, 64, wide_filter).unwrap();
+    b1.render(&f, &mut wide, 0, 2).unwrap();
+    assert!(diff(&wide) < 0.7 * diff(&sharp), "wide {} vs box {}", diff(&wide), diff(&sharp));
+    assert!((wide.total()[0] - sharp.total()[0]).abs() < 1e-6 * sharp.total()[0]);
+    assert_eq!(Filter::adaptive(16.0), Filter::Tent);
+}

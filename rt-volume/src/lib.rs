@@ -66,6 +66,8 @@ pub use grid::{Grid, GridError, GridField, Interp};
 pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
 #[cfg(feature = "alloc")]
 pub use skip::{build_octree, trace_skipping};
-pub use trace::{Exit, Method, TraceError, TraceParams, TraceResult, TraceStats, trace};
+pub use trace::{
+    Exit, Method, TraceError, TraceParams, TraceResult, TraceStats, trace, trace_visiting,
+};
 
 pub use glam;

@@ -41,36 +41,43 @@ pub fn trace_skipping(
     let (o, h) = (g.origin(), g.spacing());
     let tiny = 1e-9 * h.min_element();
     let cells = (DVec3::from(g.dims().map(|d| d as f64)) - 1.0).to_array();
-    trace_impl(field, origin, direction, params, |x, d| {
-        // The outer half cells repeat the edge samples (zero slope across
-        // the faces), so the edge nodes' statistics cover them too.
-        let p = ((x - o) / h).to_array();
-        let q = [0, 1, 2].map(|a| p[a].clamp(0.0, cells[a]));
-        let mut node = tree.smooth_node(q, tolerance)?;
-        for ((lo, hi), c) in node.lo.iter_mut().zip(&mut node.hi).zip(cells) {
-            if *lo <= 0.0 {
-                *lo = -0.5;
+    trace_impl(
+        field,
+        origin,
+        direction,
+        params,
+        |x, d| {
+            // The outer half cells repeat the edge samples (zero slope across
+            // the faces), so the edge nodes' statistics cover them too.
+            let p = ((x - o) / h).to_array();
+            let q = [0, 1, 2].map(|a| p[a].clamp(0.0, cells[a]));
+            let mut node = tree.smooth_node(q, tolerance)?;
+            for ((lo, hi), c) in node.lo.iter_mut().zip(&mut node.hi).zip(cells) {
+                if *lo <= 0.0 {
+                    *lo = -0.5;
+                }
+                if *hi >= c {
+                    *hi = c + 0.5;
+                }
             }
-            if *hi >= c {
-                *hi = c + 0.5;
+            // Distance along d to the node's far faces (world units).
+            let mut len = f64::INFINITY;
+            for a in 0..3 {
+                let face = if d[a] > 0.0 {
+                    node.hi[a]
+                } else if d[a] < 0.0 {
+                    node.lo[a]
+                } else {
+                    continue;
+                };
+                len = len.min((o[a] + face * h[a] - x[a]) / d[a]);
             }
-        }
-        // Distance along d to the node's far faces (world units).
-        let mut len = f64::INFINITY;
-        for a in 0..3 {
-            let face = if d[a] > 0.0 {
-                node.hi[a]
-            } else if d[a] < 0.0 {
-                node.lo[a]
-            } else {
-                continue;
-            };
-            len = len.min((o[a] + face * h[a] - x[a]) / d[a]);
-        }
-        let len = len.max(0.0) + tiny;
-        let n_min = f64::from(node.stats.min).max(1e-6);
-        Some((len, f64::from(node.stats.grad_max) * len / n_min))
-    })
+            let len = len.max(0.0) + tiny;
+            let n_min = f64::from(node.stats.min).max(1e-6);
+            Some((len, f64::from(node.stats.grad_max) * len / n_min))
+        },
+        |_| {},
+    )
 }
 
 #[cfg(test)]

@@ -233,7 +233,22 @@ pub fn trace<F: IndexField>(
     direction: DVec3,
     params: &TraceParams,
 ) -> Result<TraceResult, TraceError> {
-    trace_impl(field, origin, direction, params, |_, _| None)
+    trace_impl(field, origin, direction, params, |_, _| None, |_| {})
+}
+
+/// [`trace`], calling `visit(x)` at the end of every step inside the
+/// bounds (for sampling a second field along the bent path).
+///
+/// # Errors
+/// As [`trace`].
+pub fn trace_visiting<F: IndexField>(
+    field: &F,
+    origin: DVec3,
+    direction: DVec3,
+    params: &TraceParams,
+    visit: impl FnMut(DVec3),
+) -> Result<TraceResult, TraceError> {
+    trace_impl(field, origin, direction, params, |_, _| None, visit)
 }
 
 /// [`trace`] with a skip oracle: before each step, `skip(x, d̂)` may return
@@ -247,6 +262,7 @@ pub(crate) fn trace_impl<F: IndexField>(
     direction: DVec3,
     params: &TraceParams,
     mut skip: impl FnMut(DVec3, DVec3) -> Option<(f64, f64)>,
+    mut visit: impl FnMut(DVec3),
 ) -> Result<TraceResult, TraceError> {
     if !(origin.is_finite() && direction.is_finite()) || direction == DVec3::ZERO {
         return Err(TraceError::InvalidRay);
@@ -302,6 +318,7 @@ pub(crate) fn trace_impl<F: IndexField>(
             stats.steps += 1;
             stats.skipped += 1;
             stats.skip_bound += bound;
+            visit(y.x);
             if !inside {
                 break;
             }
@@ -313,6 +330,7 @@ pub(crate) fn trace_impl<F: IndexField>(
         };
         if bounds.contains(next.x) {
             y = next;
+            visit(y.x);
             travelled += used;
             stats.steps += 1;
             stats.error_estimate += err;
