@@ -253,7 +253,7 @@ pub fn trace_visiting<F: IndexField>(
 
 /// [`trace`] with a skip oracle: before each step, `skip(x, d̂)` may return
 /// `(length, bound)`: the ray then moves `length` straight along `d̂`
-/// (`T` unchanged, optical path by the midpoint index), and `bound` (the
+/// (`T` unchanged, optical path by the trapezoid rule), and `bound` (the
 /// deflection that straight move may have missed) is added to
 /// [`TraceStats::skip_bound`].
 pub(crate) fn trace_impl<F: IndexField>(
@@ -307,13 +307,15 @@ pub(crate) fn trace_impl<F: IndexField>(
             // A skip that would leave the bounds stops on their surface.
             let inside = bounds.contains(y.x + len * d);
             let len = if inside { len } else { bounds.clip(y.x, d).map_or(0.0, |(_, t1)| t1) };
-            let (n_mid, _) = ev.n(y.x + 0.5 * len * d)?;
             let x = y.x + len * d;
             let x = if inside { x } else { x.clamp(bounds.min, bounds.max) };
             // Straight across a smooth region: T keeps its direction and
-            // |T| = n where the ray lands.
+            // |T| = n where the ray lands; the optical path by the trapezoid
+            // rule (n varies by less than the skip tolerance there). The
+            // start value is the cached evaluation of the previous step.
+            let (n_start, _) = ev.n(y.x)?;
             let (n_end, _) = ev.n(x)?;
-            y = State { x, t: n_end * d, opl: y.opl + n_mid * len };
+            y = State { x, t: n_end * d, opl: y.opl + 0.5 * (n_start + n_end) * len };
             travelled += len;
             stats.steps += 1;
             stats.skipped += 1;
