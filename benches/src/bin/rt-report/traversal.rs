@@ -67,13 +67,8 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
     for s in &scenes {
         let ntri = s.mesh.indices.len();
         eprintln!("{}: {ntri} triangles", s.name);
-        let leaf = std::env::var("RT_LEAF").ok().and_then(|v| v.parse().ok()).unwrap_or(4);
-        let bvh = build_triangles(
-            &s.mesh.positions,
-            &s.mesh.indices,
-            &BuildParams { max_leaf_size: leaf, ..BuildParams::medium() },
-        )
-        .map_err(|e| e.to_string())?;
+        let bvh = build_triangles(&s.mesh.positions, &s.mesh.indices, &BuildParams::medium())
+            .map_err(|e| e.to_string())?;
         let tris: Vec<Triangle> = s
             .mesh
             .indices
