@@ -101,7 +101,11 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     /// [`BvhRef::closest_hit`] with a caller-owned stack.
     #[must_use]
     pub fn closest_hit_with(&self, ray: &Ray, stack: &mut TraversalStack) -> Option<Hit> {
-        let best = self.closest_t_with(ray, stack)?;
+        self.record(self.closest_t_with(ray, stack)?, ray)
+    }
+
+    /// The full hit record of a traversal's best hit.
+    fn record(&self, best: BestHit, ray: &Ray) -> Option<Hit> {
         self.items[best.item as usize].hit(best.lane, ray, best.t)
     }
 
@@ -109,7 +113,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     pub fn closest_hit_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
         let ctx = RayCtx::new(ray)?;
         let best = self.closest_best(&ctx, stats, &mut TraversalStack::new());
-        best.is_hit().then(|| self.items[best.item as usize].hit(best.lane, ray, best.t))?
+        best.is_hit().then(|| self.record(best, ray))?
     }
 
     /// The closest hit's `t`, primitive and leaf position, without the full

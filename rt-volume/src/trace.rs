@@ -351,7 +351,8 @@ pub(crate) fn trace_impl<F: IndexField>(
     Ok(TraceResult { position: y.x, direction: y.t.normalize(), optical_path: y.opl, exit, stats })
 }
 
-/// One step of a fixed-step method.
+/// One step of size `h` (for `Adaptive`: one uncontrolled Dormand–Prince
+/// step).
 fn fixed_step<F: IndexField>(
     m: Method,
     ev: &mut Eval<'_, F>,
@@ -363,7 +364,9 @@ fn fixed_step<F: IndexField>(
             let k = ev.deriv(y)?;
             y.axpy(h, &k)
         }
-        Method::Rk4 | Method::Adaptive => {
+        // One Dormand–Prince step without control (the landing step).
+        Method::Adaptive => dopri(ev, y, h)?.0,
+        Method::Rk4 => {
             let k1 = ev.deriv(y)?;
             let k2 = ev.deriv(&y.axpy(0.5 * h, &k1))?;
             let k3 = ev.deriv(&y.axpy(0.5 * h, &k2))?;
@@ -456,17 +459,18 @@ fn adaptive_step<F: IndexField>(
             return Ok((next, used, err));
         }
         stats.rejected += 1;
+        let tried = *h;
         *h *= factor;
         if stats.rejected + stats.steps >= params.max_steps || *h < 1e-300 {
             // Give up controlling: accept (the caller stops on max_steps).
-            return Ok((next, *h / factor, err));
+            return Ok((next, tried, err));
         }
     }
 }
 
-/// Finds the step `h* ∈ (0, h]` from `y` whose end lies on the bounds face
-/// the step crossed, by the Illinois variant of regula falsi on the signed
-/// distance to that face, and returns the state there.
+/// Finds the step `h* ∈ (0, h]` from `y` whose end lies on the bounds'
+/// surface, by the Illinois variant of regula falsi on the signed distance
+/// outside the box, and returns the state there, snapped onto the face.
 fn land_on_boundary<F: IndexField>(
     m: Method,
     ev: &mut Eval<'_, F>,
@@ -494,12 +498,6 @@ fn land_on_boundary<F: IndexField>(
         worst
     };
     let g = |s: &State| outside_by(s).0;
-    let step = |ev: &mut Eval<'_, F>, hh: f64| -> Result<State, TraceError> {
-        match m {
-            Method::Adaptive => dopri(ev, y, hh).map(|r| r.0),
-            _ => fixed_step(m, ev, y, hh),
-        }
-    };
     let (mut lo, mut g_lo) = (0.0, g(y));
     let (mut hi, mut g_hi) = (h, g(outside));
     let mut landed = *outside;
@@ -508,7 +506,7 @@ fn land_on_boundary<F: IndexField>(
     for _ in 0..60 {
         let hm = if g_hi != g_lo { hi - g_hi * (hi - lo) / (g_hi - g_lo) } else { 0.5 * (lo + hi) };
         let hm = if hm > lo && hm < hi { hm } else { 0.5 * (lo + hi) };
-        let s = step(ev, hm)?;
+        let s = fixed_step(m, ev, y, hm)?;
         let gm = g(&s);
         landed = s;
         if gm.abs() <= tol || hi - lo <= 1e-15 * h {
