@@ -54,6 +54,8 @@ pub struct SmoothNode {
     pub lo: [f64; 3],
     /// Upper corner.
     pub hi: [f64; 3],
+    /// Its level (0: a brick).
+    pub level: usize,
     /// Its statistics.
     pub stats: OctNode,
 }
@@ -66,10 +68,11 @@ pub struct Octree {
     side: usize,
     /// Dual cells per axis.
     cells: [usize; 3],
-    /// World size of one dual cell.
-    spacing: [f64; 3],
     /// Levels, finest first; level `l` has `(side >> l)³` nodes, x fastest.
     levels: Vec<Vec<OctNode>>,
+    /// World diagonal of a level's (unclipped) node, finest first: a bound
+    /// on every node's own diagonal there.
+    diag: Vec<f64>,
 }
 
 /// Why an octree could not be built.
@@ -169,7 +172,13 @@ impl Octree {
             levels.push(next);
             s = n;
         }
-        Ok(Self { side, cells, spacing, levels })
+        let diag = (0..levels.len())
+            .map(|l| {
+                let size = (BRICK << l) as f64;
+                sqrt(spacing.iter().map(|h| (size * h) * (size * h)).sum())
+            })
+            .collect();
+        Ok(Self { side, cells, levels, diag })
     }
 
     /// Number of levels (finest is 0).
@@ -184,30 +193,79 @@ impl Octree {
         self.levels.last().map_or(OctNode::EMPTY, |l| l[0])
     }
 
-    /// The largest node containing the sample-coordinate point `p` that a
-    /// ray may cross straight (`grad_max · diagonal < tolerance`), or
-    /// `None` where even the brick holding `p` is not smooth enough (or `p`
-    /// lies outside the cells).
+    /// The finest-level brick holding the sample-coordinate point `p`, or
+    /// `None` outside the cells. Points in one brick share their answer to
+    /// [`Octree::smooth_node`] whenever the brick itself is not smooth.
     #[must_use]
-    pub fn smooth_node(&self, p: [f64; 3], tolerance: f64) -> Option<SmoothNode> {
+    pub fn brick_of(&self, p: [f64; 3]) -> Option<[usize; 3]> {
         if (0..3).any(|a| !(p[a] >= 0.0 && p[a] <= self.cells[a] as f64)) {
             return None;
         }
-        // Brick coordinates at the finest level.
-        let b = [0, 1, 2].map(|a| ((p[a] as usize).min(self.cells[a] - 1)) / BRICK);
-        for l in (0..self.levels.len()).rev() {
+        Some([0, 1, 2].map(|a| ((p[a] as usize).min(self.cells[a] - 1)) / BRICK))
+    }
+
+    /// The largest node containing the sample-coordinate point `p` that a
+    /// ray may cross straight (`grad_max · diagonal < tolerance`, with the
+    /// diagonal of an unclipped node of its level), or `None` where even
+    /// the brick holding `p` is not smooth enough (or `p` lies outside the
+    /// cells).
+    #[must_use]
+    pub fn smooth_node(&self, p: [f64; 3], tolerance: f64) -> Option<SmoothNode> {
+        self.smooth_node_near(p, tolerance, self.levels.len() - 1)
+    }
+
+    /// [`Octree::smooth_node`], searching from level `hint` (e.g. the
+    /// level of the previous node a ray crossed: neighbours tend to share
+    /// it). The answer does not depend on the hint: a node's
+    /// `grad_max · diagonal` never decreases from child to parent, so the
+    /// smooth ancestors of a brick are exactly the levels below some `L`.
+    #[must_use]
+    pub fn smooth_node_near(&self, p: [f64; 3], tolerance: f64, hint: usize) -> Option<SmoothNode> {
+        self.smooth_node_in(self.brick_of(p)?, tolerance, hint)
+    }
+
+    /// [`Octree::smooth_node_near`] for the brick `b` (as returned by
+    /// [`Octree::brick_of`]); `None` also for a brick outside the tree.
+    #[must_use]
+    pub fn smooth_node_in(&self, b: [usize; 3], tolerance: f64, hint: usize) -> Option<SmoothNode> {
+        if b.iter().any(|&v| v >= self.side) {
+            return None;
+        }
+        let top = self.levels.len() - 1;
+        let node_at = |l: usize| {
             let s = self.side >> l;
             let idx = [b[0] >> l, b[1] >> l, b[2] >> l];
-            let node = self.levels[l][idx[0] + s * (idx[1] + s * idx[2])];
-            let size = (BRICK << l) as f64;
-            let lo = idx.map(|v| v as f64 * size);
-            let hi = [0, 1, 2].map(|a| (lo[a] + size).min(self.cells[a] as f64));
-            let diag = sqrt((0..3).map(|a| ((hi[a] - lo[a]) * self.spacing[a]).powi(2)).sum());
-            if f64::from(node.grad_max) * diag < tolerance {
-                return Some(SmoothNode { lo, hi, stats: node });
+            (idx, self.levels[l][idx[0] + s * (idx[1] + s * idx[2])])
+        };
+        let smooth = |n: &OctNode, l: usize| f64::from(n.grad_max) * self.diag[l] < tolerance;
+        let mut l = hint.min(top);
+        let (mut idx, mut node) = node_at(l);
+        if smooth(&node, l) {
+            // Up while the parent is smooth too.
+            while l < top {
+                let (pi, pn) = node_at(l + 1);
+                if !smooth(&pn, l + 1) {
+                    break;
+                }
+                (l, idx, node) = (l + 1, pi, pn);
+            }
+        } else {
+            // Down until smooth (or the brick itself is not).
+            loop {
+                if l == 0 {
+                    return None;
+                }
+                l -= 1;
+                (idx, node) = node_at(l);
+                if smooth(&node, l) {
+                    break;
+                }
             }
         }
-        None
+        let size = (BRICK << l) as f64;
+        let lo = idx.map(|v| v as f64 * size);
+        let hi = [0, 1, 2].map(|a| (lo[a] + size).min(self.cells[a] as f64));
+        Some(SmoothNode { lo, hi, level: l, stats: node })
     }
 }
 
@@ -249,5 +307,44 @@ mod tests {
         assert!(t.smooth_node([-1.0, 3.0, 3.0], 1.0).is_none());
         assert_eq!(Octree::build([1, 2, 2], &[0.0; 4], [1.0; 3]), Err(OctreeError::BadDims));
         assert_eq!(Octree::build([2, 2, 2], &[f32::NAN; 8], [1.0; 3]), Err(OctreeError::NonFinite));
+    }
+
+    #[test]
+    fn the_search_hint_never_changes_the_answer() {
+        // Two bumps of different strength on 33³ samples: nodes of every
+        // level are smooth somewhere for some tolerance.
+        let n = 33;
+        let data: alloc::vec::Vec<f32> = (0..n * n * n)
+            .map(|i| {
+                let (x, y, z) = ((i % n) as f32, ((i / n) % n) as f32, (i / (n * n)) as f32);
+                let b = |cx: f32, a: f32| {
+                    a * (-((x - cx).powi(2) + (y - 9.0).powi(2) + (z - 20.0).powi(2)) / 8.0).exp()
+                };
+                1.0 + b(6.0, 1e-2) + b(26.0, 1e-4)
+            })
+            .collect();
+        let t = Octree::build([n; 3], &data, [0.1; 3]).unwrap();
+        let mut smooth_levels = [0usize; 8];
+        for tol in [1e-7, 1e-5, 1e-3, 1e-1, 1.0] {
+            for k in (0..32).step_by(3) {
+                for j in (0..32).step_by(5) {
+                    for i in 0..32 {
+                        let p = [i as f64 + 0.5, j as f64 + 0.25, k as f64 + 0.75];
+                        let want = t.smooth_node(p, tol);
+                        if let Some(w) = want {
+                            smooth_levels[w.level] += 1;
+                        }
+                        for hint in 0..=t.levels() {
+                            assert_eq!(
+                                t.smooth_node_near(p, tol, hint),
+                                want,
+                                "{p:?} {tol} {hint}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        assert!(smooth_levels[..t.levels()].iter().all(|&c| c > 0), "{smooth_levels:?}");
     }
 }

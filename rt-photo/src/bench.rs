@@ -6,7 +6,10 @@ use core::fmt;
 use glam::DVec3;
 use rt_core::ColorMap;
 use rt_core::sampling::{rng_for, uniform};
-use rt_volume::{IndexField, TraceError, TraceParams, TraceResult, trace, trace_visiting};
+use rt_volume::{
+    GridField, IndexField, Interp, Octree, TraceError, TraceParams, TraceResult, trace,
+    trace_skipping, trace_visiting,
+};
 
 use crate::{Cutoff, Film};
 
@@ -84,7 +87,7 @@ pub struct Bench {
 }
 
 /// One traced photon: film coordinates (pixels), weight, deflection.
-type Landing = (f64, f64, [f32; 3], (f64, f64));
+type Landing = crate::Photon;
 
 impl Bench {
     fn v(&self) -> DVec3 {
@@ -213,6 +216,59 @@ impl Bench {
         self.render_with(&|o, d| trace(field, o, d, &self.params), film, pass, seed)
     }
 
+    /// The per-node tolerance for octree skipping (see
+    /// [`rt_volume::trace_skipping`]) that this bench cannot see: a
+    /// quarter of the smallest deflection it resolves, taken as 1/1000 of
+    /// what changes the cutoff's transmission fully ([`Cutoff::range`]).
+    /// Without a cutoff the film position resolves it: 1/1000 of a pixel
+    /// after the film distance `L` (any skip is invisible at `L = 0`;
+    /// capped at 1e-3 rad). Interferometry resolves optical path: 1/1000
+    /// of a wavelength over the field's extent.
+    #[must_use]
+    pub fn skip_tolerance(&self, field: &GridField, film: &Film) -> f64 {
+        let resolvable = match &self.mode {
+            Mode::Schlieren(c) => c.range().unwrap_or_else(|| {
+                let pixel = (self.width / film.width().max(1) as f64)
+                    .min(self.height / film.height().max(1) as f64);
+                pixel / self.film_distance.abs()
+            }),
+            Mode::Interferometry { lambda, .. } => {
+                let b = field.bounds();
+                lambda / (b.max - b.min).length()
+            }
+        } / 1000.0;
+        (0.25 * resolvable).min(1e-3)
+    }
+
+    /// [`Bench::render`] for a gridded field, rt's default: the octree
+    /// `tree` (from [`rt_volume::build_octree`]) lets photons cross the
+    /// field's smooth regions in straight steps, with the tolerance the
+    /// bench cannot resolve ([`Bench::skip_tolerance`]). Pair it with
+    /// [`TraceParams::for_grid`]. Fields interpolated other than
+    /// trilinearly are traced without skipping.
+    ///
+    /// # Errors
+    /// As [`Bench::render`].
+    pub fn render_grid(
+        &self,
+        field: &GridField,
+        tree: &Octree,
+        film: &mut Film,
+        pass: u64,
+        seed: u64,
+    ) -> Result<(), BenchError> {
+        if field.interp() != Interp::Trilinear {
+            return self.render(field, film, pass, seed);
+        }
+        let tol = self.skip_tolerance(field, film);
+        self.render_with(
+            &|o, d| trace_skipping(field, tree, o, d, &self.params, tol),
+            film,
+            pass,
+            seed,
+        )
+    }
+
     /// [`Bench::render`] with any tracer `(origin, direction) → result`,
     /// e.g. octree skipping over a gridded field:
     /// `|o, d| rt_volume::trace_skipping(&grid, &tree, o, d, &params, tol)`.
@@ -275,12 +331,8 @@ impl Bench {
         let traced: Vec<Result<Vec<Landing>, BenchError>> =
             rows.iter().map(|&r| self.row(tracer, film, r, pass, seed)).collect();
         let traced: Vec<Vec<Landing>> = traced.into_iter().collect::<Result<_, _>>()?;
-        for row in traced {
-            for (x, y, w, e) in row {
-                film.emitted += 1;
-                film.splat(x, y, w, e);
-            }
-        }
+        film.emitted += traced.iter().map(|r| r.len() as u64).sum::<u64>();
+        film.splat_all(traced.iter().flatten());
         film.per_pixel += f64::from(self.strata * self.strata);
         Ok(())
     }

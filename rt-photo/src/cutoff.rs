@@ -161,6 +161,21 @@ impl Cutoff {
         }
     }
 
+    /// The deflection (radians) over which the transmission changes fully:
+    /// `h/f` for a knife edge, `width/f` for a graded filter, `radius/f`
+    /// for a pinhole, one filter pixel (`2·half_range/size`) for a colour
+    /// filter; `None` without a cutoff.
+    #[must_use]
+    pub fn range(&self) -> Option<f64> {
+        match self {
+            Self::None => None,
+            Self::KnifeEdge { f, h, .. } => Some(h / f),
+            Self::Graded { f, width, .. } => Some(width / f),
+            Self::Pinhole { f, radius, .. } => Some(radius / f),
+            Self::Color(img) => Some(2.0 * img.half_range / img.size.max(1) as f64),
+        }
+    }
+
     /// Transmission per channel for deflection `(eu, ev)`.
     #[must_use]
     pub fn transmit(&self, eu: f64, ev: f64) -> [f32; 3] {

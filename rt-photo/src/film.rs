@@ -29,6 +29,10 @@ impl Filter {
     }
 }
 
+/// A photon landed on the film: pixel coordinates `(x, y)`, RGB weight,
+/// deflection `(εu, εv)`.
+pub type Photon = (f64, f64, [f32; 3], (f64, f64));
+
 /// Accumulated photon weight per pixel (RGB), the mean deflection per pixel
 /// (the picking pass), and photon bookkeeping.
 #[derive(Clone, Debug, PartialEq)]
@@ -84,82 +88,67 @@ impl Film {
     /// coordinates `(x, y)` (pixel `(i, j)` spans `[i, i+1) × [j, j+1)`),
     /// with its deflection for the picking pass.
     pub fn splat(&mut self, x: f64, y: f64, w: [f32; 3], eps: (f64, f64)) {
-        let (wd, ht) = (self.width as f64, self.height as f64);
-        if !(x >= 0.0 && y >= 0.0 && x < wd && y < ht) {
+        if !self.on_film(x, y) {
             self.lost += 1;
             return;
         }
-        let mut add = |i: usize, j: usize, k: f64| {
-            let p = i + self.width * j;
-            for (acc, wc) in self.rgb[p].iter_mut().zip(w) {
-                *acc += k * f64::from(wc);
-            }
-            self.eps[p][0] += k * eps.0;
-            self.eps[p][1] += k * eps.1;
-            self.eps[p][2] += k;
-        };
-        match self.filter {
-            Filter::Box => add(x as usize, y as usize, 1.0),
-            Filter::WideTent { radius } => {
-                // Separable tent over the pixel centres within `radius`;
-                // normalised over the pixels on the film.
-                let r = radius.max(1.0);
-                let (i0, i1) =
-                    (((x - r - 0.5).ceil()).max(0.0), ((x + r - 0.5).floor()).min(wd - 1.0));
-                let (j0, j1) =
-                    (((y - r - 0.5).ceil()).max(0.0), ((y + r - 0.5).floor()).min(ht - 1.0));
-                let tent = |d: f64| (1.0 - d.abs() / r).max(0.0);
-                let mut total = 0.0;
-                let mut j = j0;
-                while j <= j1 {
-                    let mut i = i0;
-                    while i <= i1 {
-                        total += tent(i + 0.5 - x) * tent(j + 0.5 - y);
-                        i += 1.0;
-                    }
-                    j += 1.0;
-                }
-                if total > 0.0 {
-                    let mut j = j0;
-                    while j <= j1 {
-                        let mut i = i0;
-                        while i <= i1 {
-                            let k = tent(i + 0.5 - x) * tent(j + 0.5 - y) / total;
-                            if k > 0.0 {
-                                add(i as usize, j as usize, k);
+        let width = self.width;
+        let (rgb, eps_acc) = (&mut self.rgb, &mut self.eps);
+        footprint(self.filter, self.width, self.height, x, y, |i, j, k| {
+            deposit(&mut rgb[i + width * j], &mut eps_acc[i + width * j], k, w, eps);
+        });
+    }
+
+    fn on_film(&self, x: f64, y: f64) -> bool {
+        x >= 0.0 && y >= 0.0 && x < self.width as f64 && y < self.height as f64
+    }
+
+    /// Splats photons `(x, y, weight, deflection)` in order: the same image,
+    /// bit for bit, as calling [`Film::splat`] on each in turn. With feature
+    /// `parallel` the film's rows are split into bands filled in parallel,
+    /// each band taking, in order, the photons whose footprint reaches it,
+    /// so every pixel still sums its contributions in the serial order.
+    pub fn splat_all<'a>(
+        &mut self,
+        photons: impl Iterator<Item = &'a Photon> + Clone + Send + Sync,
+    ) {
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            let (width, height, filter) = (self.width, self.height, self.filter);
+            let lost = photons.clone().filter(|p| !self.on_film(p.0, p.1)).count();
+            // Rows a photon's footprint may reach beyond its own.
+            let reach = match filter {
+                Filter::Box => 0.0,
+                Filter::Tent => 1.0,
+                Filter::WideTent { radius } => radius.max(1.0) + 1.0,
+            };
+            let bands = rayon::current_num_threads().clamp(1, height);
+            let rows = height.div_ceil(bands);
+            self.rgb
+                .par_chunks_mut(rows * width)
+                .zip(self.eps.par_chunks_mut(rows * width))
+                .enumerate()
+                .for_each(|(b, (rgb, eps_acc))| {
+                    let (lo, hi) = (b * rows, (b * rows + rgb.len() / width));
+                    for &(x, y, w, e) in photons.clone() {
+                        let on = x >= 0.0 && y >= 0.0 && x < width as f64 && y < height as f64;
+                        if !on || y + reach < lo as f64 || y - reach >= hi as f64 {
+                            continue;
+                        }
+                        footprint(filter, width, height, x, y, |i, j, k| {
+                            if (lo..hi).contains(&j) {
+                                let p = i + width * (j - lo);
+                                deposit(&mut rgb[p], &mut eps_acc[p], k, w, e);
                             }
-                            i += 1.0;
-                        }
-                        j += 1.0;
+                        });
                     }
-                } else {
-                    add(x as usize, y as usize, 1.0);
-                }
-            }
-            Filter::Tent => {
-                // Bilinear weights to the four nearest pixel centres; weights
-                // falling off the film are renormalised onto the rest, so
-                // every photon deposits exactly 1.
-                let (u, v) = (x - 0.5, y - 0.5);
-                let (i0, j0) = (u.floor(), v.floor());
-                let (fx, fy) = (u - i0, v - j0);
-                let mut cells = [(0usize, 0usize, 0.0f64); 4];
-                let mut total = 0.0;
-                let mut n = 0;
-                for (di, wi) in [(0.0, 1.0 - fx), (1.0, fx)] {
-                    for (dj, wj) in [(0.0, 1.0 - fy), (1.0, fy)] {
-                        let (i, j) = (i0 + di, j0 + dj);
-                        if i >= 0.0 && j >= 0.0 && i < wd && j < ht && wi * wj > 0.0 {
-                            cells[n] = (i as usize, j as usize, wi * wj);
-                            total += wi * wj;
-                            n += 1;
-                        }
-                    }
-                }
-                for &(i, j, k) in &cells[..n] {
-                    add(i, j, k / total);
-                }
-            }
+                });
+            self.lost += lost as u64;
+        }
+        #[cfg(not(feature = "parallel"))]
+        for &(x, y, w, e) in photons {
+            self.splat(x, y, w, e);
         }
     }
 
@@ -182,5 +171,90 @@ impl Film {
     #[must_use]
     pub fn mean_deflection(&self) -> Vec<Option<(f64, f64)>> {
         self.eps.iter().map(|e| (e[2] > 0.0).then(|| (e[0] / e[2], e[1] / e[2]))).collect()
+    }
+}
+
+/// Adds a photon's share `k` of weight `w` and deflection `eps` to a pixel.
+#[inline]
+fn deposit(rgb: &mut [f64; 3], acc: &mut [f64; 3], k: f64, w: [f32; 3], eps: (f64, f64)) {
+    for (a, wc) in rgb.iter_mut().zip(w) {
+        *a += k * f64::from(wc);
+    }
+    acc[0] += k * eps.0;
+    acc[1] += k * eps.1;
+    acc[2] += k;
+}
+
+/// Calls `add(i, j, k)` for every pixel of the filter's footprint around
+/// the on-film point `(x, y)`, shares `k` summing to 1.
+fn footprint(
+    filter: Filter,
+    width: usize,
+    height: usize,
+    x: f64,
+    y: f64,
+    mut add: impl FnMut(usize, usize, f64),
+) {
+    let (wd, ht) = (width as f64, height as f64);
+    match filter {
+        Filter::Box => add(x as usize, y as usize, 1.0),
+        Filter::WideTent { radius } => {
+            // Separable tent over the pixel centres within `radius`;
+            // normalised over the pixels on the film.
+            let r = radius.max(1.0);
+            let (i0, i1) = (((x - r - 0.5).ceil()).max(0.0), ((x + r - 0.5).floor()).min(wd - 1.0));
+            let (j0, j1) = (((y - r - 0.5).ceil()).max(0.0), ((y + r - 0.5).floor()).min(ht - 1.0));
+            let tent = |d: f64| (1.0 - d.abs() / r).max(0.0);
+            let mut total = 0.0;
+            let mut j = j0;
+            while j <= j1 {
+                let mut i = i0;
+                while i <= i1 {
+                    total += tent(i + 0.5 - x) * tent(j + 0.5 - y);
+                    i += 1.0;
+                }
+                j += 1.0;
+            }
+            if total > 0.0 {
+                let mut j = j0;
+                while j <= j1 {
+                    let mut i = i0;
+                    while i <= i1 {
+                        let k = tent(i + 0.5 - x) * tent(j + 0.5 - y) / total;
+                        if k > 0.0 {
+                            add(i as usize, j as usize, k);
+                        }
+                        i += 1.0;
+                    }
+                    j += 1.0;
+                }
+            } else {
+                add(x as usize, y as usize, 1.0);
+            }
+        }
+        Filter::Tent => {
+            // Bilinear weights to the four nearest pixel centres; weights
+            // falling off the film are renormalised onto the rest, so
+            // every photon deposits exactly 1.
+            let (u, v) = (x - 0.5, y - 0.5);
+            let (i0, j0) = (u.floor(), v.floor());
+            let (fx, fy) = (u - i0, v - j0);
+            let mut cells = [(0usize, 0usize, 0.0f64); 4];
+            let mut total = 0.0;
+            let mut n = 0;
+            for (di, wi) in [(0.0, 1.0 - fx), (1.0, fx)] {
+                for (dj, wj) in [(0.0, 1.0 - fy), (1.0, fy)] {
+                    let (i, j) = (i0 + di, j0 + dj);
+                    if i >= 0.0 && j >= 0.0 && i < wd && j < ht && wi * wj > 0.0 {
+                        cells[n] = (i as usize, j as usize, wi * wj);
+                        total += wi * wj;
+                        n += 1;
+                    }
+                }
+            }
+            for &(i, j, k) in &cells[..n] {
+                add(i, j, k / total);
+            }
+        }
     }
 }

@@ -31,4 +31,4 @@ mod film;
 
 pub use bench::{Bench, BenchError, Mode, Weighting};
 pub use cutoff::{Cutoff, FilterImage};
-pub use film::{Film, Filter};
+pub use film::{Film, Filter, Photon};

@@ -307,3 +307,103 @@ fn adaptive_radius_reduces_noise_at_few_photons() {
     assert!((wide.total()[0] - sharp.total()[0]).abs() < 1e-6 * sharp.total()[0]);
     assert_eq!(Filter::adaptive(16.0), Filter::Tent);
 }
+
+/// A Gaussian bump sampled on a 64³ grid over `[-3, 3]³`, trilinear.
+fn gridded_bump() -> rt_volume::GridField {
+    use rt_volume::{Grid, GridField, Interp};
+    let n = 64;
+    let h = 6.0 / n as f64;
+    let origin = DVec3::splat(-3.0 + 0.5 * h);
+    let mut data = Vec::with_capacity(n * n * n);
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                let p = origin + DVec3::new(i as f64, j as f64, k as f64) * h;
+                data.push((1.0 + 1e-3 * (-p.length_squared() / (2.0 * 0.5 * 0.5)).exp()) as f32);
+            }
+        }
+    }
+    let g = Grid::new([n; 3], origin, DVec3::splat(h), data).unwrap();
+    GridField::new(g, Interp::Trilinear, 1.0).unwrap()
+}
+
+/// rt's default for grids (octree skipping at the bench's tolerance)
+/// renders what plain tracing renders, within what the optics resolve,
+/// and stays bit-identical across thread counts.
+#[test]
+fn grid_render_with_octree_matches_plain_tracing() {
+    let f = gridded_bump();
+    let tree = rt_volume::build_octree(&f).unwrap();
+    let b = Bench { params: TraceParams::for_grid(&f), ..bench(knife(300.0), 2) };
+    let mut film = Film::new(64, 64, Filter::Box).unwrap();
+    assert_eq!(b.skip_tolerance(&f, &film), 0.25 * (1.0 / 300.0) / 1000.0);
+    let mut plain = film.clone();
+    b.render(&f, &mut plain, 0, 5).unwrap();
+    let render = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut film = Film::new(64, 64, Filter::Box).unwrap();
+            b.render_grid(&f, &tree, &mut film, 0, 5).unwrap();
+            film
+        })
+    };
+    film = render(1);
+    assert_eq!(film, render(3));
+    let (a, p) = (film.normalized(), plain.normalized());
+    let worst = a.iter().zip(&p).map(|(x, y)| (x[0] - y[0]).abs()).fold(0.0f32, f32::max);
+    // Skipped nodes may each miss a quarter of a resolvable deflection
+    // (1/1000 of the knife's range); a ray crosses a handful of them.
+    assert!(worst < 0.005, "octree image differs from plain tracing by {worst}");
+    let signal = p.iter().map(|x| (x[0] - 0.5).abs()).fold(0.0f32, f32::max);
+    assert!(signal > 0.2, "the bump shows: {signal}");
+}
+
+/// The tolerance follows the optics: the cutoff's range, the film's pixel
+/// after `L`, or the wavelength.
+#[test]
+fn skip_tolerance_follows_the_optics() {
+    let f = gridded_bump();
+    let film = Film::new(60, 30, Filter::Box).unwrap();
+    let shadow = Bench { film_distance: 100.0, ..bench(Mode::Schlieren(Cutoff::None), 1) };
+    // Pixel 0.1 (6/60), seen 100 further: 1e-3 rad; a quarter of 1/1000.
+    assert!((shadow.skip_tolerance(&f, &film) - 0.25e-6).abs() < 1e-18);
+    // At L = 0 without a cutoff nothing is resolved: the cap.
+    let plain = bench(Mode::Schlieren(Cutoff::None), 1);
+    assert_eq!(plain.skip_tolerance(&f, &film), 1e-3);
+    let interf = bench(Mode::Interferometry { lambda: 5e-4, n_ref: 1.0, fringe_spacing: None }, 1);
+    let want = 0.25 * 5e-4 / (6.0 * 3f64.sqrt()) / 1000.0;
+    assert!((interf.skip_tolerance(&f, &film) - want).abs() < 1e-15 * want.max(1e-300) + 1e-20);
+}
+
+/// Splatting in parallel bands deposits exactly what serial splatting
+/// does, for every filter, with photons on and off the film.
+#[test]
+fn parallel_splat_equals_serial_splat() {
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let photons: Vec<rt_photo::Photon> = (0..20_000)
+        .map(|_| {
+            let (x, y) = (next() * 44.0 - 2.0, next() * 34.0 - 2.0);
+            let w = [next() as f32, next() as f32, 1.0];
+            (x, y, w, (next() - 0.5, next() - 0.5))
+        })
+        .collect();
+    for filter in [Filter::Box, Filter::Tent, Filter::WideTent { radius: 2.5 }] {
+        let mut serial = Film::new(40, 30, filter).unwrap();
+        for &(x, y, w, e) in &photons {
+            serial.splat(x, y, w, e);
+        }
+        for threads in [1, 2, 7] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let mut banded = Film::new(40, 30, filter).unwrap();
+            pool.install(|| banded.splat_all(photons.iter()));
+            assert_eq!(serial, banded, "{filter:?} with {threads} threads");
+        }
+        assert!(serial.lost > 0 && serial.lost < 20_000);
+    }
+}

@@ -65,6 +65,9 @@ pub use field::{Bounds, IndexField};
 pub use grid::{Grid, GridError, GridField, Interp};
 pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
 #[cfg(feature = "alloc")]
+#[cfg(feature = "alloc")]
+pub use rt_accel::Octree;
+#[cfg(feature = "alloc")]
 pub use skip::{build_octree, trace_skipping};
 pub use trace::{
     Exit, Method, TraceError, TraceParams, TraceResult, TraceStats, trace, trace_visiting,

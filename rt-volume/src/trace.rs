@@ -251,17 +251,28 @@ pub fn trace_visiting<F: IndexField>(
     trace_impl(field, origin, direction, params, |_, _| None, visit)
 }
 
-/// [`trace`] with a skip oracle: before each step, `skip(x, d̂)` may return
-/// `(length, bound)`: the ray then moves `length` straight along `d̂`
-/// (`T` unchanged, optical path by the trapezoid rule), and `bound` (the
-/// deflection that straight move may have missed) is added to
+/// A straight move offered by a skip oracle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Skip {
+    /// Length along the current direction.
+    pub len: f64,
+    /// The deflection the straight move may miss.
+    pub bound: f64,
+    /// The index where it is known to be this constant along the whole
+    /// move (no field evaluation needed at its ends).
+    pub n: Option<f64>,
+}
+
+/// [`trace`] with a skip oracle: before each step, `skip(x, T)` may return
+/// a [`Skip`]: the ray then moves `len` straight along `d̂ = T/|T|` (`T` keeps its
+/// direction, optical path by the trapezoid rule), and `bound` is added to
 /// [`TraceStats::skip_bound`].
 pub(crate) fn trace_impl<F: IndexField>(
     field: &F,
     origin: DVec3,
     direction: DVec3,
     params: &TraceParams,
-    mut skip: impl FnMut(DVec3, DVec3) -> Option<(f64, f64)>,
+    mut skip: impl FnMut(DVec3, DVec3) -> Option<Skip>,
     mut visit: impl FnMut(DVec3),
 ) -> Result<TraceResult, TraceError> {
     if !(origin.is_finite() && direction.is_finite()) || direction == DVec3::ZERO {
@@ -288,11 +299,19 @@ pub(crate) fn trace_impl<F: IndexField>(
     };
     // Straight through the ambient medium to the entry point.
     let x0 = origin + t0 * d;
-    let (n0, _) = ev.n(x0)?;
+    // The first skip is asked before the first evaluation: a ray that only
+    // crosses constant regions needs none.
+    let mut first = Some(skip(x0, d));
+    let n0 = match first {
+        Some(Some(Skip { n: Some(n), .. })) => n,
+        _ => ev.n(x0)?.0,
+    };
     let mut y = State { x: x0, t: n0 * d, opl: ambient * t0 };
     let mut h = params.step.min(params.max_step);
     let mut travelled = 0.0;
     let mut exit = Exit::Left;
+    // The index at `y.x` where a skip knew it without evaluating.
+    let mut known_here = None;
     loop {
         if stats.steps + stats.rejected >= params.max_steps {
             exit = Exit::MaxSteps;
@@ -302,7 +321,11 @@ pub(crate) fn trace_impl<F: IndexField>(
             exit = Exit::MaxLength;
             break;
         }
-        if let Some((len, bound)) = skip(y.x, y.t.normalize()) {
+        let offer = match first.take() {
+            Some(offer) => offer,
+            None => skip(y.x, y.t),
+        };
+        if let Some(Skip { len, bound, n: known }) = offer {
             let d = y.t.normalize();
             // A skip that would leave the bounds stops on their surface.
             let inside = bounds.contains(y.x + len * d);
@@ -313,13 +336,16 @@ pub(crate) fn trace_impl<F: IndexField>(
             // |T| = n where the ray lands; the optical path by the trapezoid
             // rule (n varies by less than the skip tolerance there). The
             // start value is the cached evaluation of the previous step.
-            let (n_start, _) = ev.n(y.x)?;
-            let (n_end, _) = ev.n(x)?;
+            let (n_start, n_end) = match known {
+                Some(n) => (n, n),
+                None => (ev.n(y.x)?.0, ev.n(x)?.0),
+            };
             y = State { x, t: n_end * d, opl: y.opl + 0.5 * (n_start + n_end) * len };
             travelled += len;
             stats.steps += 1;
             stats.skipped += 1;
             stats.skip_bound += bound;
+            known_here = known;
             visit(y.x);
             if !inside {
                 break;
@@ -330,6 +356,7 @@ pub(crate) fn trace_impl<F: IndexField>(
             Method::Adaptive => adaptive_step(&mut ev, &y, &mut h, params, &mut stats)?,
             m => (fixed_step(m, &mut ev, &y, h)?, h, 0.0),
         };
+        known_here = None;
         if bounds.contains(next.x) {
             y = next;
             visit(y.x);
@@ -345,8 +372,11 @@ pub(crate) fn trace_impl<F: IndexField>(
         y = land_on_boundary(params.method, &mut ev, &y, &next, used, &mut stats)?;
         break;
     }
+    let n = match known_here {
+        Some(n) => n,
+        None => ev.n(y.x)?.0,
+    };
     stats.field_evals = ev.evals;
-    let (n, _) = ev.n(y.x)?;
     stats.invariant_drift = stats.invariant_drift.max((y.t.length() - n).abs());
     Ok(TraceResult { position: y.x, direction: y.t.normalize(), optical_path: y.opl, exit, stats })
 }
