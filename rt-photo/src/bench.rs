@@ -152,6 +152,10 @@ impl Bench {
         let mut rng = rng_for(seed ^ pass.wrapping_mul(0x9e37_79b9_7f4a_7c15), row as u64);
         let mut out = Vec::with_capacity(w * k * k);
         let v = self.v();
+        let cutoff = match &self.mode {
+            Mode::Schlieren(c) => Some(c.prepare()),
+            Mode::Interferometry { .. } => None,
+        };
         for i in 0..w {
             for s in 0..k * k {
                 // Stratified and jittered inside the pixel's footprint.
@@ -172,8 +176,8 @@ impl Bench {
                 let fx = (fa / self.width + 0.5) * w as f64;
                 let fy = (0.5 - fb / self.height) * h as f64;
                 let weight = match &self.mode {
-                    Mode::Schlieren(c) => {
-                        let t = c.transmit(eu, ev);
+                    Mode::Schlieren(_) => {
+                        let t = cutoff.as_ref().map_or([1.0; 3], |p| p.transmit(eu, ev));
                         match self.weighting {
                             Weighting::Weight => t,
                             Weighting::Roulette => {

@@ -179,20 +179,44 @@ impl Cutoff {
     /// Transmission per channel for deflection `(eu, ev)`.
     #[must_use]
     pub fn transmit(&self, eu: f64, ev: f64) -> [f32; 3] {
-        let along = |a: f64| eu * a.cos() + ev * a.sin();
+        self.prepare().transmit(eu, ev)
+    }
+
+    /// The cutoff with its edge direction's sine and cosine computed once,
+    /// for transmitting many photons.
+    pub(crate) fn prepare(&self) -> Prepared<'_> {
+        let angle = match self {
+            Self::KnifeEdge { angle, .. } | Self::Graded { angle, .. } => *angle,
+            _ => 0.0,
+        };
+        Prepared { cutoff: self, cos: angle.cos(), sin: angle.sin() }
+    }
+}
+
+/// A [`Cutoff`] with its edge direction precomputed.
+pub(crate) struct Prepared<'a> {
+    cutoff: &'a Cutoff,
+    cos: f64,
+    sin: f64,
+}
+
+impl Prepared<'_> {
+    /// As [`Cutoff::transmit`].
+    pub(crate) fn transmit(&self, eu: f64, ev: f64) -> [f32; 3] {
+        let along = eu * self.cos + ev * self.sin;
         let gray = |t: f64| {
             let t = t.clamp(0.0, 1.0) as f32;
             [t; 3]
         };
-        match self {
-            Self::None => [1.0; 3],
-            Self::KnifeEdge { angle, offset, f, h } => gray(0.5 + f / h * along(*angle) + offset),
-            Self::Graded { angle, f, width } => gray(0.5 + f * along(*angle) / width),
-            Self::Pinhole { f, radius, dark_field } => {
+        match self.cutoff {
+            Cutoff::None => [1.0; 3],
+            Cutoff::KnifeEdge { offset, f, h, .. } => gray(0.5 + f / h * along + offset),
+            Cutoff::Graded { f, width, .. } => gray(0.5 + f * along / width),
+            Cutoff::Pinhole { f, radius, dark_field } => {
                 let inside = f * (eu * eu + ev * ev).sqrt() <= *radius;
                 gray(if inside != *dark_field { 1.0 } else { 0.0 })
             }
-            Self::Color(img) => img.at(eu, ev),
+            Cutoff::Color(img) => img.at(eu, ev),
         }
     }
 }
