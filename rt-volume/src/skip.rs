@@ -70,13 +70,13 @@ pub fn trace_skipping(
             let inv = ds.recip();
             let (mut t, mut bound) = (0.0, 0.0);
             let mut hint = usize::MAX;
-            // The index while every node so far is one constant.
-            let mut constant: Option<Option<f32>> = None;
+            // Whether every node so far holds the one constant `value`.
+            let (mut uniform, mut value) = (true, None);
             // The outer half cells repeat the edge samples (zero slope
             // across the faces), so the edge nodes' statistics cover them
             // too.
             while let Some(brick) = tree.brick_of(clamp(p0 + t * ds)) {
-                if t > 0.0 && Some(brick) == rough {
+                if Some(brick) == rough {
                     break;
                 }
                 let Some(node) = tree.smooth_node_in(brick, tolerance, hint) else {
@@ -108,11 +108,8 @@ pub fn trace_skipping(
                 bound += f64::from(node.stats.grad_max) * (next - t);
                 t = next;
                 let (lo, hi) = (node.stats.min, node.stats.max);
-                constant = Some(match constant {
-                    None if lo == hi => Some(lo),
-                    Some(Some(c)) if lo == hi && hi == c => Some(c),
-                    _ => None,
-                });
+                uniform &= lo == hi && value.is_none_or(|c| c == lo);
+                value = Some(lo);
                 if leaves {
                     break;
                 }
@@ -120,7 +117,7 @@ pub fn trace_skipping(
             (t > 0.0).then(|| Skip {
                 len: t,
                 bound: bound / n_min,
-                n: constant.flatten().map(f64::from),
+                n: value.filter(|_| uniform).map(f64::from),
             })
         },
         |_| {},

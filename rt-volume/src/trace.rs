@@ -264,9 +264,9 @@ pub(crate) struct Skip {
 }
 
 /// [`trace`] with a skip oracle: before each step, `skip(x, T)` may return
-/// a [`Skip`]: the ray then moves `len` straight along `d̂ = T/|T|` (`T` keeps its
-/// direction, optical path by the trapezoid rule), and `bound` is added to
-/// [`TraceStats::skip_bound`].
+/// a [`Skip`]: the ray then moves `len` straight along `d̂ = T/|T|` (`T`
+/// keeps its direction, optical path by the trapezoid rule), and `bound`
+/// is added to [`TraceStats::skip_bound`].
 pub(crate) fn trace_impl<F: IndexField>(
     field: &F,
     origin: DVec3,
