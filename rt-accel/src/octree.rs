@@ -270,6 +270,45 @@ impl Octree {
 }
 
 #[cfg(feature = "alloc")]
+impl Octree {
+    /// Covers the cells with the largest smooth nodes (the ones
+    /// [`Octree::smooth_node`] returns) and the bricks that are not smooth,
+    /// calling `f(node, smooth)` once for each, in no particular order.
+    /// Each node's box is clipped to the cells, as there.
+    pub fn partition(&self, tolerance: f64, mut f: impl FnMut(&SmoothNode, bool)) {
+        self.partition_at(self.levels.len() - 1, [0; 3], tolerance, &mut f);
+    }
+
+    fn partition_at(
+        &self,
+        l: usize,
+        idx: [usize; 3],
+        tolerance: f64,
+        f: &mut impl FnMut(&SmoothNode, bool),
+    ) {
+        let size = (BRICK << l) as f64;
+        let lo = idx.map(|v| v as f64 * size);
+        if (0..3).any(|a| lo[a] >= self.cells[a] as f64) {
+            return;
+        }
+        let s = self.side >> l;
+        let stats = self.levels[l][idx[0] + s * (idx[1] + s * idx[2])];
+        // Top down, the first smooth node is the largest: smoothness only
+        // grows from parent to child.
+        let smooth = f64::from(stats.grad_max) * self.diag[l] < tolerance;
+        if smooth || l == 0 {
+            let hi = [0, 1, 2].map(|a| (lo[a] + size).min(self.cells[a] as f64));
+            f(&SmoothNode { lo, hi, level: l, stats }, smooth);
+            return;
+        }
+        for c in 0..8 {
+            let child = [2 * idx[0] + (c & 1), 2 * idx[1] + ((c >> 1) & 1), 2 * idx[2] + (c >> 2)];
+            self.partition_at(l - 1, child, tolerance, f);
+        }
+    }
+}
+
+#[cfg(feature = "alloc")]
 fn sqrt(x: f64) -> f64 {
     // Newton's method seeded by the f32 root: enough for a bound, and
     // keeps the module free of std/libm.
@@ -346,5 +385,41 @@ mod tests {
             }
         }
         assert!(smooth_levels[..t.levels()].iter().all(|&c| c > 0), "{smooth_levels:?}");
+    }
+
+    #[test]
+    fn the_partition_tiles_the_cells_with_the_nodes_smooth_node_finds() {
+        // The two-bump field on 29³ samples (28 cells: a partial brick
+        // row on the padded side), several tolerances.
+        let n = 29;
+        let data: alloc::vec::Vec<f32> = (0..n * n * n)
+            .map(|i| {
+                let (x, y, z) = ((i % n) as f32, ((i / n) % n) as f32, (i / (n * n)) as f32);
+                let r2 = (x - 7.0).powi(2) + (y - 9.0).powi(2) + (z - 20.0).powi(2);
+                1.0 + 1e-2 * (-r2 / 8.0).exp()
+            })
+            .collect();
+        let t = Octree::build([n; 3], &data, [0.1; 3]).unwrap();
+        for tol in [1e-7, 1e-4, 1e-3, 1e-2, 1.0] {
+            let mut volume = 0.0;
+            let (mut rough, mut smooth) = (0, 0);
+            t.partition(tol, |node, is_smooth| {
+                volume += (0..3).map(|a| node.hi[a] - node.lo[a]).product::<f64>();
+                let mid = [0, 1, 2].map(|a| 0.5 * (node.lo[a] + node.hi[a]));
+                if is_smooth {
+                    smooth += 1;
+                    assert_eq!(t.smooth_node(mid, tol).as_ref(), Some(node), "{tol} {mid:?}");
+                } else {
+                    rough += 1;
+                    assert_eq!(node.level, 0);
+                    assert!(t.smooth_node(mid, tol).is_none(), "{tol} {mid:?}");
+                }
+            });
+            // Disjoint boxes (each is what smooth_node returns for its
+            // points) whose volumes add up to the cells': a tiling.
+            assert_eq!(volume, 28.0f64.powi(3), "{tol}");
+            assert!(tol > 1e-3 || rough > 0, "{tol}");
+            assert!(tol < 1e-4 || smooth > 0, "{tol}");
+        }
     }
 }

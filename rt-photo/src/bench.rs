@@ -7,8 +7,8 @@ use glam::DVec3;
 use rt_core::ColorMap;
 use rt_core::sampling::{rng_for, uniform};
 use rt_volume::{
-    GridField, IndexField, Interp, Octree, TraceError, TraceParams, TraceResult, trace,
-    trace_skipping, trace_visiting,
+    BeamMask, BeamWindow, GridField, IndexField, Interp, Octree, TraceError, TraceParams,
+    TraceResult, trace, trace_beam, trace_visiting,
 };
 
 use crate::{Cutoff, Film};
@@ -247,7 +247,9 @@ impl Bench {
     /// [`Bench::render`] for a gridded field, rt's default: the octree
     /// `tree` (from [`rt_volume::build_octree`]) lets photons cross the
     /// field's smooth regions in straight steps, with the tolerance the
-    /// bench cannot resolve ([`Bench::skip_tolerance`]). Pair it with
+    /// bench cannot resolve ([`Bench::skip_tolerance`]); photons whose line
+    /// meets no node too rough for it (a [`BeamMask`] with one cell per
+    /// film pixel) go straight without walking the tree. Pair it with
     /// [`TraceParams::for_grid`]. Fields interpolated other than
     /// trilinearly are traced without skipping.
     ///
@@ -264,9 +266,18 @@ impl Bench {
         if field.interp() != Interp::Trilinear {
             return self.render(field, film, pass, seed);
         }
-        let tol = self.skip_tolerance(field, film);
+        self.validate(film)?;
+        let window = BeamWindow {
+            center: self.center,
+            direction: self.direction,
+            u: self.u,
+            size: [self.width, self.height],
+            cells: [film.width(), film.height()],
+        };
+        let mask = BeamMask::build(field, tree, &window, self.skip_tolerance(field, film))
+            .map_err(BenchError::Trace)?;
         self.render_with(
-            &|o, d| trace_skipping(field, tree, o, d, &self.params, tol),
+            &|o, d| trace_beam(field, tree, &mask, o, d, &self.params),
             film,
             pass,
             seed,

@@ -46,6 +46,8 @@ extern crate alloc;
 extern crate std;
 
 mod analytic;
+#[cfg(feature = "alloc")]
+mod beam;
 mod field;
 #[cfg(feature = "alloc")]
 mod grid;
@@ -60,11 +62,12 @@ mod trace;
 pub use analytic::{
     Constant, FnField, GaussianBump, GrinRod, LinearIndex, LinearSquared, Luneburg,
 };
+#[cfg(feature = "alloc")]
+pub use beam::{BeamMask, BeamWindow, MAX_BEAM_CELLS, trace_beam};
 pub use field::{Bounds, IndexField};
 #[cfg(feature = "alloc")]
 pub use grid::{Grid, GridError, GridField, Interp};
 pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
-#[cfg(feature = "alloc")]
 #[cfg(feature = "alloc")]
 pub use rt_accel::Octree;
 #[cfg(feature = "alloc")]

@@ -263,6 +263,16 @@ pub(crate) struct Skip {
     pub n: Option<f64>,
 }
 
+/// Step, tolerance and limits finite and positive.
+pub(crate) fn check_params(params: &TraceParams) -> Result<(), TraceError> {
+    let ok = |v: f64| v.is_finite() && v > 0.0;
+    if !(ok(params.step) && ok(params.tolerance) && ok(params.max_length)) || params.max_steps == 0
+    {
+        return Err(TraceError::InvalidParams);
+    }
+    Ok(())
+}
+
 /// [`trace`] with a skip oracle: before each step, `skip(x, T)` may return
 /// a [`Skip`]: the ray then moves `len` straight along `d̂ = T/|T|` (`T`
 /// keeps its direction, optical path by the trapezoid rule), and `bound`
@@ -278,11 +288,7 @@ pub(crate) fn trace_impl<F: IndexField>(
     if !(origin.is_finite() && direction.is_finite()) || direction == DVec3::ZERO {
         return Err(TraceError::InvalidRay);
     }
-    let ok = |v: f64| v.is_finite() && v > 0.0;
-    if !(ok(params.step) && ok(params.tolerance) && ok(params.max_length)) || params.max_steps == 0
-    {
-        return Err(TraceError::InvalidParams);
-    }
+    check_params(params)?;
     let d = direction.normalize();
     let bounds = field.bounds();
     let ambient = field.ambient();

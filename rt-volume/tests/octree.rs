@@ -3,7 +3,8 @@
 use glam::DVec3;
 use proptest::prelude::*;
 use rt_volume::{
-    Grid, GridField, Interp, Method, TraceParams, build_octree, trace, trace_skipping,
+    BeamMask, BeamWindow, Grid, GridField, Interp, Method, TraceError, TraceParams, build_octree,
+    trace, trace_beam, trace_skipping,
 };
 
 /// A 40³ field on the unit cube: ambient 1 plus compact Gaussian blobs.
@@ -83,4 +84,102 @@ fn sparse_fields_are_mostly_skipped() {
         es += trace_skipping(&f, &tree, o, DVec3::Z, &p, 1e-5).unwrap().stats.field_evals;
     }
     assert!(es * 3 < eu, "skipping {es} vs uniform {eu}");
+}
+
+/// A beam mask's clear cells are exactly safe: every ray through one is
+/// answered as the skip chain answers it (straight, no integration step),
+/// for an axis-aligned and an oblique beam; most of a sparse field's beam
+/// is clear, the rays through the blobs are not.
+#[test]
+fn beam_mask_clear_rays_are_what_skipping_gives() {
+    let f = blobs(&[(0.3, 0.3, 0.5, 2e-3, 0.04), (0.7, 0.6, 0.4, 1e-3, 0.03)]);
+    let tree = build_octree(&f).unwrap();
+    let p = TraceParams::for_grid(&f);
+    for (direction, u) in
+        [(DVec3::Z, DVec3::X), (DVec3::new(0.3, -0.2, 1.0), DVec3::new(1.0, 0.5, 0.0))]
+    {
+        for tol in [1e-6, 1e-4] {
+            let window = BeamWindow {
+                center: DVec3::new(0.5, 0.5, 0.5) - direction.normalize(),
+                direction,
+                u,
+                size: [1.3, 1.3],
+                cells: [48, 40],
+            };
+            let mask = BeamMask::build(&f, &tree, &window, tol).unwrap();
+            let (uu, vv) = {
+                let d = direction.normalize();
+                let uu = (u - d * d.dot(u)).normalize();
+                (uu, d.cross(uu))
+            };
+            let (mut clear, mut blocked) = (0, 0);
+            for j in 0..97 {
+                for i in 0..101 {
+                    let a = (i as f64 / 100.0 - 0.5) * 1.3;
+                    let b = (j as f64 / 96.0 - 0.5) * 1.3;
+                    let o = window.center + a * uu + b * vv;
+                    let want = trace_skipping(&f, &tree, o, direction, &p, tol).unwrap();
+                    let got = trace_beam(&f, &tree, &mask, o, direction, &p).unwrap();
+                    if mask.clear_at(o).is_none() {
+                        assert_eq!(got, want, "{o}");
+                        blocked += usize::from(want.stats.steps > want.stats.skipped);
+                        continue;
+                    }
+                    clear += 1;
+                    assert_eq!(want.stats.steps, want.stats.skipped, "clear ray integrated: {o}");
+                    assert_eq!(got.exit, want.exit);
+                    assert!((got.position - want.position).length() < 1e-9, "{o}");
+                    assert!((got.direction - want.direction).length() < 1e-12, "{o}");
+                    assert!((got.optical_path - want.optical_path).abs() < 1e-9, "{o}");
+                    assert!(
+                        got.stats.skip_bound >= want.stats.skip_bound * (1.0 - 1e-6),
+                        "{o} {} {}",
+                        got.stats.skip_bound,
+                        want.stats.skip_bound
+                    );
+                }
+            }
+            let total = 97 * 101;
+            assert!(clear * 2 > total, "{tol}: only {clear} of {total} clear");
+            assert!(blocked > 50, "{tol}: {blocked} rays met a rough brick");
+            assert!(mask.clear_fraction() > 0.3 && mask.clear_fraction() < 1.0);
+        }
+    }
+}
+
+#[test]
+fn beam_mask_rejects_bad_windows_and_other_fields() {
+    let f = blobs(&[(0.5, 0.5, 0.5, 1e-3, 0.05)]);
+    let tree = build_octree(&f).unwrap();
+    let w = BeamWindow {
+        center: DVec3::new(0.5, 0.5, -1.0),
+        direction: DVec3::Z,
+        u: DVec3::X,
+        size: [1.0, 1.0],
+        cells: [8, 8],
+    };
+    let bad = |w: BeamWindow, tol: f64| BeamMask::build(&f, &tree, &w, tol).is_err();
+    assert!(!bad(w, 1e-5));
+    assert!(bad(w, 0.0) && bad(w, f64::NAN));
+    assert!(bad(BeamWindow { u: DVec3::Z, ..w }, 1e-5));
+    assert!(bad(BeamWindow { direction: DVec3::ZERO, ..w }, 1e-5));
+    assert!(bad(BeamWindow { size: [1.0, f64::INFINITY], ..w }, 1e-5));
+    assert!(bad(BeamWindow { cells: [0, 8], ..w }, 1e-5));
+    assert!(bad(BeamWindow { cells: [usize::MAX, 2], ..w }, 1e-5));
+    // A mask of another field is refused, not trusted.
+    let mask = BeamMask::build(&f, &tree, &w, 1e-5).unwrap();
+    let g = Grid::new([9; 3], DVec3::ZERO, DVec3::splat(0.1), vec![1.0; 729]).unwrap();
+    let other = GridField::new(g, Interp::Trilinear, 1.0).unwrap();
+    let p = TraceParams::for_grid(&f);
+    assert_eq!(
+        trace_beam(&other, &tree, &mask, w.center, DVec3::Z, &p),
+        Err(TraceError::InvalidParams)
+    );
+    // NaN rays and bad parameters are the skipping tracer's errors.
+    let nan = DVec3::new(f64::NAN, 0.5, -1.0);
+    assert_eq!(trace_beam(&f, &tree, &mask, nan, DVec3::Z, &p), Err(TraceError::InvalidRay));
+    let zero = TraceParams { step: 0.0, ..p };
+    let o = DVec3::new(0.05, 0.05, -1.0);
+    assert!(mask.clear_at(o).is_some());
+    assert_eq!(trace_beam(&f, &tree, &mask, o, DVec3::Z, &zero), Err(TraceError::InvalidParams));
 }
