@@ -2,6 +2,7 @@
 
 use glam::Vec3;
 use rt_core::{Camera, Projection, Ray, glam::Vec2, sampling};
+use rt_volume::{Grid, GridField, Interp, glam::DVec3};
 
 /// An indexed triangle mesh.
 #[derive(Clone, Debug, Default)]
@@ -109,4 +110,60 @@ pub fn incoherent_rays(lo: Vec3, hi: Vec3, count: usize, seed: u64) -> Vec<Ray> 
             Ray::new(o, Vec3::new(r * phi.cos(), r * phi.sin(), z))
         })
         .collect()
+}
+
+/// Samples per axis of the report's bump fields.
+pub const BUMP_GRID: usize = 128;
+
+/// Ambient 1 plus Gaussian bumps `(centre, amplitude, σ)` on the unit cube.
+pub fn bump_grid(bumps: &[(DVec3, f64, f64)]) -> GridField {
+    let h = 1.0 / BUMP_GRID as f64;
+    let origin = DVec3::splat(0.5 * h);
+    let mut data = Vec::with_capacity(BUMP_GRID.pow(3));
+    for k in 0..BUMP_GRID {
+        for j in 0..BUMP_GRID {
+            for i in 0..BUMP_GRID {
+                let p = origin + DVec3::new(i as f64, j as f64, k as f64) * h;
+                let v: f64 = 1.0
+                    + bumps
+                        .iter()
+                        .map(|(c, a, s)| a * (-(p - *c).length_squared() / (2.0 * s * s)).exp())
+                        .sum::<f64>();
+                data.push(v as f32);
+            }
+        }
+    }
+    GridField::new(
+        Grid::new([BUMP_GRID; 3], origin, DVec3::splat(h), data).expect("grid"),
+        Interp::Trilinear,
+        1.0,
+    )
+    .expect("field")
+}
+
+/// Four compact bumps (σ = 0.02): their gradients fill well under 10 % of
+/// the volume.
+pub fn sparse_bumps() -> GridField {
+    bump_grid(&[
+        (DVec3::new(0.3, 0.3, 0.3), 3e-3, 0.02),
+        (DVec3::new(0.7, 0.35, 0.6), 2e-3, 0.02),
+        (DVec3::new(0.4, 0.7, 0.5), 3e-3, 0.02),
+        (DVec3::new(0.65, 0.7, 0.25), 1e-3, 0.02),
+    ])
+}
+
+/// Forty broad bumps (σ = 0.08) that overlap everywhere.
+pub fn dense_bumps() -> GridField {
+    let bumps: Vec<_> = (0..40)
+        .map(|i| {
+            let t = f64::from(i);
+            let c = DVec3::new(
+                (t * 0.618).fract(),
+                (t * 0.382 + 0.1).fract(),
+                (t * 0.7548 + 0.3).fract(),
+            );
+            (c, 1e-3, 0.08)
+        })
+        .collect();
+    bump_grid(&bumps)
 }

@@ -5,66 +5,10 @@
 use std::{fmt::Write as _, path::Path};
 
 use glam::DVec3;
-use rt_volume::{
-    Grid, GridField, Interp, Method, TraceParams, TraceResult, build_octree, trace, trace_skipping,
-};
+use rt_benches::scenes::{BUMP_GRID, dense_bumps, sparse_bumps};
+use rt_volume::{Method, TraceParams, TraceResult, build_octree, trace, trace_skipping};
 
 use crate::timing::time;
-
-const N: usize = 128;
-
-/// Ambient 1 plus Gaussian bumps `(centre, amplitude, σ)` on the unit cube.
-fn field(bumps: &[(DVec3, f64, f64)]) -> GridField {
-    let h = 1.0 / N as f64;
-    let origin = DVec3::splat(0.5 * h);
-    let mut data = Vec::with_capacity(N * N * N);
-    for k in 0..N {
-        for j in 0..N {
-            for i in 0..N {
-                let p = origin + DVec3::new(i as f64, j as f64, k as f64) * h;
-                let v: f64 = 1.0
-                    + bumps
-                        .iter()
-                        .map(|(c, a, s)| a * (-(p - *c).length_squared() / (2.0 * s * s)).exp())
-                        .sum::<f64>();
-                data.push(v as f32);
-            }
-        }
-    }
-    GridField::new(
-        Grid::new([N; 3], origin, DVec3::splat(h), data).expect("grid"),
-        Interp::Trilinear,
-        1.0,
-    )
-    .expect("field")
-}
-
-/// Four compact bumps (σ = 0.02): their gradients fill well under 10 % of
-/// the volume.
-pub(crate) fn sparse() -> GridField {
-    field(&[
-        (DVec3::new(0.3, 0.3, 0.3), 3e-3, 0.02),
-        (DVec3::new(0.7, 0.35, 0.6), 2e-3, 0.02),
-        (DVec3::new(0.4, 0.7, 0.5), 3e-3, 0.02),
-        (DVec3::new(0.65, 0.7, 0.25), 1e-3, 0.02),
-    ])
-}
-
-/// Forty broad bumps (σ = 0.08) that overlap everywhere.
-fn dense() -> GridField {
-    let bumps: Vec<_> = (0..40)
-        .map(|i| {
-            let t = f64::from(i);
-            let c = DVec3::new(
-                (t * 0.618).fract(),
-                (t * 0.382 + 0.1).fract(),
-                (t * 0.7548 + 0.3).fract(),
-            );
-            (c, 1e-3, 0.08)
-        })
-        .collect();
-    field(&bumps)
-}
 
 /// A 32 × 32 beam of parallel rays along z through the unit cube.
 fn beam() -> Vec<(DVec3, DVec3)> {
@@ -77,7 +21,7 @@ fn beam() -> Vec<(DVec3, DVec3)> {
 }
 
 pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
-    let params = TraceParams::fixed(Method::Rk4, 0.5 / N as f64);
+    let params = TraceParams::fixed(Method::Rk4, 0.5 / BUMP_GRID as f64);
     let rays = beam();
     let rays = if quick { &rays[..256] } else { &rays[..] };
     let mut csv = String::from("field,method,field_evals,seconds,max_deflection_error,tolerance\n");
@@ -85,7 +29,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
         "| field | method | tolerance | field evals | seconds | max deflection error | ≤ tolerance | evals vs uniform |\n|---|---|---|---|---|---|---|---|\n",
     );
     let mut verdict = String::new();
-    for (name, f) in [("sparse", sparse()), ("dense", dense())] {
+    for (name, f) in [("sparse", sparse_bumps()), ("dense", dense_bumps())] {
         let tree = build_octree(&f).map_err(|e| e.to_string())?;
         let go = |skip: Option<f64>| -> Result<(f64, Vec<TraceResult>), String> {
             let (secs, out) = time(|| {

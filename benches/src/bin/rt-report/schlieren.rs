@@ -7,11 +7,14 @@
 use std::{fmt::Write as _, path::Path};
 
 use glam::DVec3;
-use rt_benches::plot::{PALETTE, Series, loglog};
+use rt_benches::{
+    plot::{PALETTE, Series, loglog},
+    scenes::sparse_bumps,
+};
 use rt_photo::{Bench, Cutoff, Film, Filter, Mode, Weighting};
 use rt_volume::{Method, TraceParams, build_octree, trace, trace_skipping};
 
-use crate::{octree::sparse, timing::time};
+use crate::timing::time;
 
 const FILM: usize = 128;
 
@@ -37,7 +40,7 @@ fn rmse(a: &Film, b: &Film) -> f64 {
 }
 
 pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
-    let f = sparse();
+    let f = sparse_bumps();
     let tree = build_octree(&f).map_err(|e| e.to_string())?;
     let h = f.grid().spacing().x;
     // Converged reference: RK4 at a quarter voxel, 256 photons per pixel,
