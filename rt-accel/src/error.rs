@@ -30,6 +30,18 @@ pub enum BuildError {
         /// Number of scalars.
         scalars: usize,
     },
+    /// A per-vertex normal array does not have one normal per vertex.
+    NormalCountMismatch {
+        /// Number of vertices.
+        vertices: usize,
+        /// Number of normals.
+        normals: usize,
+    },
+    /// A vertex normal is NaN, infinite or zero.
+    BadNormal {
+        /// Index of the vertex.
+        vertex: usize,
+    },
     /// Refit data do not match the BVH (different primitive count).
     RefitMismatch,
     /// More primitives than the node layout can address (2²⁷ leaf items).
@@ -50,6 +62,12 @@ impl fmt::Display for BuildError {
             }
             Self::ScalarCountMismatch { vertices, scalars } => {
                 write!(f, "{scalars} scalars given for {vertices} vertices")
+            }
+            Self::NormalCountMismatch { vertices, normals } => {
+                write!(f, "{normals} normals given for {vertices} vertices")
+            }
+            Self::BadNormal { vertex } => {
+                write!(f, "normal of vertex {vertex} is not finite or zero")
             }
             Self::RefitMismatch => write!(f, "refit data do not match the BVH's primitives"),
             Self::TooManyPrimitives => write!(f, "too many primitives for one BVH"),

@@ -20,7 +20,7 @@
 //! |---|---|---|
 //! | `std` | yes | std float functions; implies `alloc` |
 //! | `alloc` | via `std` | owned [`Bvh`], [`Scene`], [`TriangleMesh`], copying loader, refit |
-//! | `obvhs` | yes | building ([`build_triangles`], [`build_spheres`], [`build_capsules`]); needs std |
+//! | `obvhs` | yes | building ([`build_triangles`], [`build_spheres`], [`build_capsules`], [`SurfaceScene`]); needs std |
 //! | `libm` | no | float functions from `libm` for `no_std` |
 //!
 //! ## Example
@@ -63,6 +63,8 @@ mod refit;
 #[cfg(feature = "alloc")]
 mod scene;
 mod simd;
+#[cfg(feature = "obvhs")]
+mod surface;
 mod traverse;
 mod tri_packet;
 
@@ -82,5 +84,7 @@ pub use prim::{BestHit, CapsuleItem, Primitive, SphereItem};
 pub use ray_ctx::RayCtx;
 #[cfg(feature = "alloc")]
 pub use scene::Scene;
+#[cfg(feature = "obvhs")]
+pub use surface::{Glyphs, Paint, SceneError, SurfaceScene, Tube};
 pub use traverse::{BvhRef, MAX_DEPTH, STACK_SIZE, TraversalStack, TraversalStats};
 pub use tri_packet::TriPacket;

@@ -13,6 +13,7 @@ pub struct TriangleMesh {
     positions: Vec<Vec3>,
     indices: Vec<[u32; 3]>,
     scalars: Option<Vec<f32>>,
+    normals: Option<Vec<Vec3>>,
 }
 
 impl TriangleMesh {
@@ -45,7 +46,7 @@ impl TriangleMesh {
                 scalars: s.len(),
             });
         }
-        Ok(Self { positions, indices, scalars })
+        Ok(Self { positions, indices, scalars, normals: None })
     }
 
     /// The unit sphere as an icosahedron subdivided `level` times
@@ -114,7 +115,46 @@ impl TriangleMesh {
             }
             indices = next;
         }
-        Self { positions, indices, scalars: None }
+        Self { positions, indices, scalars: None, normals: None }
+    }
+
+    /// The mesh with per-vertex shading normals (any non-zero length).
+    ///
+    /// # Errors
+    /// [`BuildError::NormalCountMismatch`] unless there is one per vertex,
+    /// [`BuildError::BadNormal`] for the first NaN/∞ or zero normal.
+    pub fn with_normals(mut self, normals: Vec<Vec3>) -> Result<Self, BuildError> {
+        if normals.len() != self.positions.len() {
+            return Err(BuildError::NormalCountMismatch {
+                vertices: self.positions.len(),
+                normals: normals.len(),
+            });
+        }
+        if let Some(vertex) = normals.iter().position(|n| !n.is_finite() || *n == Vec3::ZERO) {
+            return Err(BuildError::BadNormal { vertex });
+        }
+        self.normals = Some(normals);
+        Ok(self)
+    }
+
+    /// Per-vertex normals, if any.
+    #[must_use]
+    pub fn normals(&self) -> Option<&[Vec3]> {
+        self.normals.as_deref()
+    }
+
+    /// The shading normal at a triangle hit: the vertex normals
+    /// interpolated with the hit's barycentrics and normalised, or the
+    /// geometric normal without normals (or where they cancel).
+    #[must_use]
+    pub fn shading_normal(&self, hit: &Hit) -> Vec3 {
+        let interpolated = self.normals.as_ref().and_then(|n| {
+            let [i0, i1, i2] = *self.indices.get(hit.prim as usize)?;
+            let (b1, b2) = (hit.uv.x, hit.uv.y);
+            let v = (1.0 - b1 - b2) * n[i0 as usize] + b1 * n[i1 as usize] + b2 * n[i2 as usize];
+            v.try_normalize()
+        });
+        interpolated.unwrap_or(hit.normal)
     }
 
     /// Vertex positions.

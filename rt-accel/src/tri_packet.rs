@@ -67,7 +67,8 @@ impl TriPacket {
     }
 
     /// The scalar test's final check ([`triangle_admits_hit`]) for a lane
-    /// the SIMD test accepted.
+    /// the SIMD test accepted; lanes failing it are redone by the scalar
+    /// test, which may settle their `t` onto the box.
     #[inline]
     fn admits(&self, lane: usize, ray: &Ray, t: f32) -> bool {
         triangle_admits_hit(
@@ -133,6 +134,9 @@ impl Primitive for TriPacket {
             ok &= ok - 1;
             if self.admits(lane as usize, &ctx.ray, t[lane as usize]) {
                 best.offer(t[lane as usize], self.prims[lane as usize], item, lane);
+            } else {
+                // Rounded below its box: the scalar test settles it.
+                edge |= 1 << lane;
             }
         }
         if edge != 0 {
@@ -156,6 +160,7 @@ impl Primitive for TriPacket {
             if self.admits(lane, &ctx.ray, t[lane]) {
                 return true;
             }
+            edge |= 1 << lane;
         }
         let r = Ray { t_max, ..ctx.ray };
         while edge != 0 {

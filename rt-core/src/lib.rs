@@ -18,8 +18,9 @@
 //! | feature | default | what it does |
 //! |---|---|---|
 //! | `std` | yes | float functions from std; implies `alloc` |
-//! | `alloc` | via `std` | [`Frame`] (owned pixel storage) |
+//! | `alloc` | via `std` | [`Frame`] (owned pixel storage), the [`render`]er |
 //! | `libm` | no | float functions from `libm` for `no_std` builds |
+//! | `parallel` | no | [`Renderer`] renders tiles on rayon (implies `std`) |
 //!
 //! Everything else (intersections, cameras, colour maps, sampling) needs
 //! neither std nor an allocator.
@@ -50,6 +51,8 @@ mod hit;
 pub mod intersect;
 mod math;
 mod ray;
+#[cfg(feature = "alloc")]
+pub mod render;
 pub mod sampling;
 
 pub use aabb::{Aabb, SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG, widen_far};
@@ -61,5 +64,9 @@ pub use hit::{Hit, PrimKind, SceneQuery};
 pub use intersect::{offset_ray_origin, spawn_ray, spawn_ray_to};
 pub use math::gamma;
 pub use ray::Ray;
+#[cfg(feature = "alloc")]
+pub use render::{
+    Light, Material, RayCounts, RenderError, Renderer, Settings, ShadeScene, Surface,
+};
 
 pub use glam;

@@ -36,15 +36,14 @@ pub fn next_float_down(x: f32) -> f32 {
 #[must_use]
 pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     let d = n.abs().dot(p_error);
-    let mut offset = d * n;
-    if w.dot(n) < 0.0 {
-        offset = -offset;
-    }
-    let mut po = p + offset;
+    let side = if w.dot(n) < 0.0 { -n } else { n };
+    let mut po = p + d * side;
+    // Rounded away along the normal even where the bound is 0 (a hit on
+    // an axis-aligned plane is exact): the origin must leave the surface.
     for i in 0..3 {
-        if offset[i] > 0.0 {
+        if side[i] > 0.0 {
             po[i] = next_float_up(po[i]);
-        } else if offset[i] < 0.0 {
+        } else if side[i] < 0.0 {
             po[i] = next_float_down(po[i]);
         }
     }

@@ -10,7 +10,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::{Aabb, Hit, PrimKind, Ray, math::gamma};
+use crate::{Aabb, Hit, PrimKind, Ray, math::gamma, widen_far};
 
 /// Per-ray constants of the watertight test: the dominant axis `kz`, the
 /// two others `kx`, `ky` (swapped to keep winding), and the shear.
@@ -102,10 +102,38 @@ pub fn intersect_triangle_t(
     let tt = u * (s.z * a[kz]) + v * (s.z * b[kz]) + w * (s.z * c[kz]);
     let inv = 1.0 / det;
     let t = tt * inv;
-    if !(t >= ray.t_min && t <= ray.t_max && triangle_admits_hit(ray, t, v0, v1, v2)) {
+    if !(t >= ray.t_min && t <= ray.t_max) {
         return None;
     }
+    // `t` interpolates the vertices' distances with the barycentrics: for
+    // a triangle large next to `t` it cancels, and can round below the
+    // near plane of the triangle's (flat) box. Within a generous bound on
+    // that rounding, it is moved onto the plane instead of rejected.
+    let terms = (u * (s.z * a[kz])).abs() + (v * (s.z * b[kz])).abs() + (w * (s.z * c[kz])).abs();
+    let slack = 8.0 * gamma(3) * terms * inv.abs();
+    let t = settle_triangle_t(ray, t, slack, v0, v1, v2)?;
     Some(TriangleHit { t, b1: v * inv, b2: w * inv })
+}
+
+/// The hit distance a triangle test reports for a computed `t` whose
+/// rounding error is at most `slack`: `t` itself where the triangle's box
+/// admits it ([`triangle_admits_hit`]), else the box's near distance if
+/// that lies within `t + slack` (and `ray.t_max`), else `None`. So the
+/// reported `t` is always one the box admits, which keeps a BVH's answer
+/// equal to a brute-force loop's.
+#[inline]
+#[must_use]
+pub fn settle_triangle_t(
+    ray: &Ray,
+    t: f32,
+    slack: f32,
+    v0: Vec3,
+    v1: Vec3,
+    v2: Vec3,
+) -> Option<f32> {
+    let bx = Aabb::new(v0.min(v1).min(v2), v0.max(v1).max(v2));
+    let (near, _) = bx.intersect_ray(&Ray { t_max: widen_far(t + slack), ..*ray })?;
+    if near <= widen_far(t) { Some(t) } else { (near <= ray.t_max).then_some(near) }
 }
 
 /// Whether a triangle hit at `t` lies inside the triangle's box as the
@@ -168,6 +196,36 @@ pub fn triangle_hit(h: TriangleHit, prim: u32, v0: Vec3, v1: Vec3, v2: Vec3) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn large_flat_triangles_seen_from_close_by_are_hit() {
+        // A wall x = 0 of two 2·s triangles; rays from 0.25 in front of it.
+        // Their t (barycentric interpolation of ±s distances) rounds below
+        // the flat box's near plane; the test must settle, not miss.
+        for s in [50.0f32, 1e3] {
+            let v = [
+                Vec3::new(0.0, 0.0, -s),
+                Vec3::new(0.0, s, -s),
+                Vec3::new(0.0, s, s),
+                Vec3::new(0.0, 0.0, s),
+            ];
+            let mut missed = 0;
+            for i in 0..2000 {
+                let a = i as f32 * 0.618_034 * core::f32::consts::TAU;
+                let up = 0.05 + 0.9 * ((i as f32 * 0.754_877) % 1.0);
+                // x is not the dominant axis: t comes from y or z.
+                let d = Vec3::new(-0.35, 0.3 + up, 0.9 * a.sin().signum()).normalize();
+                let r = Ray::new(Vec3::new(0.25, 0.0, a.cos()), d);
+                let h = intersect_triangle(&r, v[0], v[1], v[2])
+                    .or_else(|| intersect_triangle(&r, v[0], v[2], v[3]));
+                match h {
+                    Some(h) => assert!((h.t - 0.25 / -d.x).abs() < 1e-3 * h.t, "{s}: {}", h.t),
+                    None => missed += 1,
+                }
+            }
+            assert_eq!(missed, 0, "{s}");
+        }
+    }
 
     const V0: Vec3 = Vec3::new(0.0, 0.0, 0.0);
     const V1: Vec3 = Vec3::new(1.0, 0.0, 0.0);

@@ -1,0 +1,427 @@
+//! The surface renderer against answers computed independently.
+
+use rt_accel::{BuildParams, Glyphs, Paint, SceneError, SurfaceScene, TriangleMesh, Tube};
+use rt_core::{
+    Camera, ColorMap, ColorStop, Frame, Light, Material, Projection, Renderer, Settings,
+    glam::Vec3, intersect::Sphere,
+};
+
+fn quad(corners: [Vec3; 4]) -> TriangleMesh {
+    TriangleMesh::new(corners.to_vec(), vec![[0, 1, 2], [0, 2, 3]], None).unwrap()
+}
+
+/// A floor `y = 0` (±50), front face up.
+fn floor() -> TriangleMesh {
+    floor_of(50.0)
+}
+
+fn floor_of(s: f32) -> TriangleMesh {
+    quad([
+        Vec3::new(-s, 0.0, -s),
+        Vec3::new(-s, 0.0, s),
+        Vec3::new(s, 0.0, s),
+        Vec3::new(s, 0.0, -s),
+    ])
+}
+
+fn solid(
+    mesh: TriangleMesh,
+    rgb: [f32; 3],
+    m: Material,
+) -> (TriangleMesh, Paint<'static>, Material) {
+    (mesh, Paint::Solid(rgb), m)
+}
+
+fn scene(meshes: Vec<(TriangleMesh, Paint<'static>, Material)>) -> SurfaceScene<'static> {
+    SurfaceScene::build(meshes, vec![], vec![], &BuildParams::medium()).unwrap()
+}
+
+fn settings(lights: Vec<Light>) -> Settings {
+    Settings { lights, ao_samples: 0, ..Settings::default() }
+}
+
+fn render(scene: &SurfaceScene<'_>, cam: Camera, s: Settings, passes: u32) -> (Frame, Renderer) {
+    let mut r = Renderer::new(cam, s).unwrap();
+    for _ in 0..passes {
+        r.render_pass(scene);
+    }
+    (r.frame().unwrap(), r)
+}
+
+/// Looking straight down at `(x, z)` from `y = 5`, one pixel.
+fn down_at(x: f32, z: f32) -> Camera {
+    Camera::look_at(
+        Vec3::new(x, 5.0, z),
+        Vec3::new(x, 0.0, z),
+        Vec3::Z,
+        Projection::Orthographic { height: 1e-4 },
+        1,
+        1,
+    )
+    .unwrap()
+}
+
+#[test]
+fn a_sphere_under_a_directional_light_is_the_lambert_image() {
+    let glyphs = Glyphs {
+        spheres: vec![Sphere::new(Vec3::ZERO, 1.0)],
+        scalars: None,
+        paint: Paint::Solid([1.0, 0.5, 0.25]),
+        material: Material::MATTE,
+    };
+    let s = SurfaceScene::build(vec![], vec![glyphs], vec![], &BuildParams::medium()).unwrap();
+    let l = Vec3::new(0.3, 0.4, 1.0).normalize();
+    let (w, h) = (64, 48);
+    let cam = Camera::look_at(
+        Vec3::new(0.0, 0.0, 5.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        Projection::Orthographic { height: 2.4 },
+        w,
+        h,
+    )
+    .unwrap();
+    let lights = vec![Light::Directional { direction: l * 3.0, color: [2.0; 3] }];
+    let (f, r) = render(&s, cam, settings(lights), 1);
+    let mut hits = 0;
+    for y in 0..h {
+        for x in 0..w {
+            // The pixel centre's ray, computed here from the projection.
+            let sx = (2.0 * (x as f32 + 0.5) / w as f32 - 1.0) * 1.2 * w as f32 / h as f32;
+            let sy = (1.0 - 2.0 * (y as f32 + 0.5) / h as f32) * 1.2;
+            let px = f.get(x, y).unwrap();
+            let r2 = sx * sx + sy * sy;
+            if r2 > 1.0 - 1e-3 {
+                if r2 > 1.0 + 1e-3 {
+                    assert_eq!((px.color, px.depth), ([0.0; 4], f32::INFINITY), "{x} {y}");
+                }
+                continue;
+            }
+            hits += 1;
+            let n = Vec3::new(sx, sy, (1.0 - r2).sqrt());
+            let lambert = 2.0 * n.dot(l).max(0.0);
+            let want = [lambert, 0.5 * lambert, 0.25 * lambert, 1.0];
+            for k in 0..4 {
+                assert!(
+                    (px.color[k] - want[k]).abs() < 2e-4,
+                    "{x} {y}: {:?} vs {want:?}",
+                    px.color
+                );
+            }
+            assert!((px.depth - (5.0 - n.z)).abs() < 1e-4);
+        }
+    }
+    assert!(hits > 1000);
+    // One light with shadows: one shadow ray per lit hit at most.
+    let c = r.counts();
+    assert!(c.shadow > 0 && c.shadow <= hits && c.ao == 0 && c.reflection == 0);
+}
+
+#[test]
+fn ambient_occlusion_of_an_open_plane_is_exactly_one() {
+    let s = scene(vec![solid(floor(), [0.5, 0.6, 0.7], Material::MATTE)]);
+    let st = Settings {
+        lights: vec![Light::Ambient { color: [1.0; 3] }],
+        ao_samples: 64,
+        ao_distance: 100.0,
+        ..Settings::default()
+    };
+    for (x, z) in [(0.0, 0.0), (12.0, -45.0), (-0.3, 7.0)] {
+        let (f, r) = render(&s, down_at(x, z), st.clone(), 4);
+        assert_eq!(f.get(0, 0).unwrap().color, [0.5, 0.6, 0.7, 1.0]);
+        assert_eq!(r.counts().ao, 4 * 64);
+    }
+}
+
+#[test]
+fn ambient_occlusion_beside_a_wall_is_the_disk_segment() {
+    // Floor y = 0 and a wall x = 0 facing +x. Cosine-weighted directions
+    // project uniformly onto the unit disk (Malley), and an AO ray of
+    // length D from distance d hits the wall iff its x-component is below
+    // −d/D: AO = 1 − (acos a − a√(1−a²))/π with a = d/D.
+    // Triangles much larger than the AO rays: the hit distance, from
+    // barycentric interpolation of large coordinates, rounds below the
+    // flat boxes' near planes; the triangle test must not lose them.
+    let s = 1e3;
+    let wall = quad([
+        Vec3::new(0.0, 0.0, -s),
+        Vec3::new(0.0, s, -s),
+        Vec3::new(0.0, s, s),
+        Vec3::new(0.0, 0.0, s),
+    ]);
+    let sc = scene(vec![
+        solid(floor_of(s), [1.0; 3], Material::MATTE),
+        solid(wall, [1.0; 3], Material::MATTE),
+    ]);
+    for (d, dist) in [(0.25f32, 1.0f32), (0.5, 4.0), (0.9, 1.0)] {
+        let samples = 4096;
+        let st = Settings {
+            lights: vec![Light::Ambient { color: [1.0; 3] }],
+            ao_samples: samples,
+            ao_distance: dist,
+            seed: 3,
+            ..Settings::default()
+        };
+        let passes = 8;
+        let (f, _) = render(&sc, down_at(d, 0.0), st, passes);
+        let a = f64::from(d / dist);
+        let want = 1.0 - (a.acos() - a * (1.0 - a * a).sqrt()) / core::f64::consts::PI;
+        let n = f64::from(samples * passes);
+        let sigma = (want * (1.0 - want) / n).sqrt();
+        let got = f64::from(f.get(0, 0).unwrap().color[0]);
+        assert!((got - want).abs() < 4.0 * sigma, "d {d} D {dist}: {got} vs {want} (σ {sigma:e})");
+    }
+}
+
+#[test]
+fn colour_maps_the_interpolated_scalar_not_interpolated_colours() {
+    static STOPS: [ColorStop; 3] = [
+        ColorStop::rgb(0.0, 1.0, 0.0, 0.0),
+        ColorStop::rgb(0.5, 0.0, 1.0, 0.0),
+        ColorStop::rgb(1.0, 0.0, 0.0, 1.0),
+    ];
+    let map = ColorMap::from_stops(&STOPS, 0.0, 1.0).unwrap();
+    // Scalar 0 at x = 0, 1 at x = 1, linear in x.
+    let mesh = TriangleMesh::new(
+        vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 0.0)],
+        vec![[0, 1, 2]],
+        Some(vec![0.0, 0.0, 1.0]),
+    )
+    .unwrap();
+    let s = SurfaceScene::build(
+        vec![(mesh, Paint::Mapped(map), Material::MATTE)],
+        vec![],
+        vec![],
+        &BuildParams::medium(),
+    )
+    .unwrap();
+    let st = settings(vec![Light::Ambient { color: [1.0; 3] }]);
+    // At scalar 0.5 the map is green; blending the vertex colours would
+    // give purple (0.5, 0, 0.5).
+    let (f, _) = render(&s, down_at(0.5, 0.25), st.clone(), 1);
+    let c = f.get(0, 0).unwrap().color;
+    assert!(c[1] > 0.999 && c[0] < 1e-3 && c[2] < 1e-3, "{c:?}");
+    let (f, _) = render(&s, down_at(0.25, 0.25), st, 1);
+    let c = f.get(0, 0).unwrap().color;
+    assert!((c[0] - 0.5).abs() < 1e-3 && (c[1] - 0.5).abs() < 1e-3 && c[2] < 1e-3, "{c:?}");
+}
+
+fn view() -> Camera {
+    Camera::look_at(
+        Vec3::new(3.0, 2.0, 4.0),
+        Vec3::new(0.0, 0.3, 0.0),
+        Vec3::Y,
+        Projection::Perspective { fov_y: 0.8 },
+        40,
+        30,
+    )
+    .unwrap()
+}
+
+fn ball_on_floor(ball: Material) -> SurfaceScene<'static> {
+    let g = Glyphs {
+        spheres: vec![Sphere::new(Vec3::new(0.0, 0.5, 0.0), 0.5)],
+        scalars: None,
+        paint: Paint::Solid([0.9, 0.2, 0.2]),
+        material: ball,
+    };
+    SurfaceScene::build(
+        vec![solid(floor(), [0.8; 3], Material::MATTE)],
+        vec![g],
+        vec![],
+        &BuildParams::medium(),
+    )
+    .unwrap()
+}
+
+#[test]
+fn counters_show_what_is_skipped() {
+    let sun = Light::Directional { direction: Vec3::new(1.0, 2.0, 0.5), color: [1.0; 3] };
+    let amb = Light::Ambient { color: [0.2; 3] };
+    let s = ball_on_floor(Material::MATTE);
+    let px = 40 * 30;
+    // No lights: nothing but camera rays (AO is on, but there is no
+    // ambient light for it to darken).
+    let st = Settings { lights: vec![], ao_samples: 8, ..Settings::default() };
+    let c = render(&s, view(), st, 1).1.counts();
+    assert_eq!((c.primary, c.total()), (px, px));
+    // A light without shadows, AO off: still only camera rays.
+    let st = Settings { lights: vec![sun, amb], shadows: false, ..settings(vec![]) };
+    assert_eq!(render(&s, view(), st, 1).1.counts().total(), px);
+    // Shadows on: shadow rays, but no AO, reflection or transparency rays.
+    let c = render(&s, view(), settings(vec![sun, amb]), 1).1.counts();
+    assert!(c.shadow > px / 2 && c.ao == 0 && c.reflection == 0 && c.transparency == 0);
+    // AO on: 8 per hit.
+    let st = Settings { ao_samples: 8, ..settings(vec![amb]) };
+    let c = render(&s, view(), st, 1).1.counts();
+    assert!(c.ao > 0 && c.ao.is_multiple_of(8) && c.shadow == 0);
+    // A mirror ball casts reflection rays, a glass one transparency rays.
+    let mirror = ball_on_floor(Material { mirror: 0.5, ..Material::MATTE });
+    let c = render(&mirror, view(), settings(vec![amb]), 1).1.counts();
+    assert!(c.reflection > 0 && c.transparency == 0);
+    let glass = ball_on_floor(Material { opacity: 0.4, ..Material::MATTE });
+    let c = render(&glass, view(), settings(vec![amb]), 1).1.counts();
+    assert!(c.transparency > 0 && c.reflection == 0);
+    // Looking away from everything: every ray is culled at the bounds.
+    let away = Camera::look_at(
+        Vec3::new(0.0, 1e5, 0.0),
+        Vec3::new(0.0, 2e5, 0.0),
+        Vec3::Z,
+        Projection::Perspective { fov_y: 0.8 },
+        8,
+        8,
+    )
+    .unwrap();
+    let c = render(&s, away, settings(vec![sun, amb]), 1).1.counts();
+    assert_eq!((c.primary, c.culled, c.shadow), (64, 64, 0));
+}
+
+#[test]
+fn translucent_layers_composite_over_in_depth_order_and_mirrors_see_the_environment() {
+    let near = quad([
+        Vec3::new(-1.0, 1.0, -1.0),
+        Vec3::new(-1.0, 1.0, 1.0),
+        Vec3::new(1.0, 1.0, 1.0),
+        Vec3::new(1.0, 1.0, -1.0),
+    ]);
+    let glass = Material { opacity: 0.25, ..Material::MATTE };
+    let s = scene(vec![
+        solid(floor(), [1.0, 0.0, 0.0], Material::MATTE),
+        solid(near, [0.0, 0.0, 1.0], glass),
+    ]);
+    let st = settings(vec![Light::Ambient { color: [1.0; 3] }]);
+    let (f, r) = render(&s, down_at(0.1, 0.2), st.clone(), 1);
+    let p = f.get(0, 0).unwrap();
+    assert_eq!(p.color, [0.75, 0.0, 0.25, 1.0]);
+    assert_eq!(p.depth, 4.0, "depth of the first surface");
+    assert_eq!(r.counts().transparency, 1);
+    // Without the floor: premultiplied, alpha 0.25.
+    let near_only = scene(vec![solid(
+        quad([
+            Vec3::new(-1.0, 1.0, -1.0),
+            Vec3::new(-1.0, 1.0, 1.0),
+            Vec3::new(1.0, 1.0, 1.0),
+            Vec3::new(1.0, 1.0, -1.0),
+        ]),
+        [0.0, 0.0, 1.0],
+        glass,
+    )]);
+    let p = *render(&near_only, down_at(0.1, 0.2), st.clone(), 1).0.get(0, 0).unwrap();
+    assert_eq!(p.color, [0.0, 0.0, 0.25, 0.25]);
+    // A perfect mirror floor under an open sky shows the environment.
+    let mirror = scene(vec![solid(floor(), [1.0; 3], Material { mirror: 1.0, ..Material::MATTE })]);
+    let st = Settings { environment: [0.2, 0.4, 0.6], ..st };
+    let p = *render(&mirror, down_at(3.0, -2.0), st, 1).0.get(0, 0).unwrap();
+    assert_eq!(p.color, [0.2, 0.4, 0.6, 1.0]);
+}
+
+#[test]
+fn frames_are_identical_at_any_thread_count() {
+    let tube = Tube {
+        points: (0..20).map(|i| Vec3::new(-1.0 + 0.1 * i as f32, 0.8, 0.3)).collect(),
+        radius: 0.05,
+        scalars: Some((0..20).map(|i| i as f32).collect()),
+        paint: Paint::Mapped(ColorMap::viridis().with_range(0.0, 19.0).unwrap()),
+        material: Material::GLOSSY,
+    };
+    let g = Glyphs {
+        spheres: vec![Sphere::new(Vec3::new(0.0, 0.5, 0.0), 0.5)],
+        scalars: Some(vec![0.3]),
+        paint: Paint::Mapped(ColorMap::cool_to_warm()),
+        material: Material { mirror: 0.3, opacity: 0.7, ..Material::GLOSSY },
+    };
+    let s = SurfaceScene::build(
+        vec![solid(floor(), [0.8; 3], Material::MATTE)],
+        vec![g],
+        vec![tube],
+        &BuildParams::medium(),
+    )
+    .unwrap();
+    let st = Settings {
+        lights: vec![
+            Light::Ambient { color: [0.3; 3] },
+            Light::Point { position: Vec3::new(1.0, 3.0, 1.0), color: [4.0; 3] },
+        ],
+        ao_samples: 4,
+        seed: 9,
+        ..Settings::default()
+    };
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let (f, r) = render(&s, view(), st.clone(), 3);
+            (f, r.counts())
+        })
+    };
+    let (one, c1) = run(1);
+    for t in [2, 5] {
+        let (f, c) = run(t);
+        assert_eq!(c, c1);
+        assert!(one.pixels().iter().zip(f.pixels()).all(|(a, b)| {
+            a.color.map(f32::to_bits) == b.color.map(f32::to_bits)
+                && a.depth.to_bits() == b.depth.to_bits()
+        }));
+    }
+}
+
+#[test]
+fn bad_geometry_is_named_and_moving_vertices_refits() {
+    let good = floor();
+    let mut pts = floor().positions().to_vec();
+    pts[2].y = f32::NAN;
+    // TriangleMesh itself names the vertex...
+    assert_eq!(
+        TriangleMesh::new(pts.clone(), vec![[0, 1, 2]], None),
+        Err(rt_accel::BuildError::NonFiniteVertex { vertex: 2 })
+    );
+    // ...and so does the scene, with the object.
+    let g = Glyphs {
+        spheres: vec![Sphere::new(Vec3::ZERO, 1.0), Sphere::new(Vec3::NAN, 1.0)],
+        scalars: None,
+        paint: Paint::Solid([1.0; 3]),
+        material: Material::MATTE,
+    };
+    let e = SurfaceScene::build(vec![], vec![g], vec![], &BuildParams::medium()).unwrap_err();
+    assert_eq!(
+        e,
+        SceneError::Build {
+            kind: "glyphs",
+            object: 0,
+            error: rt_accel::BuildError::InvalidPrimitive { index: 1 }
+        }
+    );
+    let bad = Material { opacity: 2.0, ..Material::MATTE };
+    let e = SurfaceScene::build(
+        vec![solid(good, [1.0; 3], bad)],
+        vec![],
+        vec![],
+        &BuildParams::medium(),
+    )
+    .unwrap_err();
+    assert!(matches!(e, SceneError::Material { kind: "mesh", object: 0, .. }));
+    // Moving the floor up by 1 is a refit, and rays see it there.
+    let mut s = scene(vec![
+        solid(floor(), [1.0; 3], Material::MATTE),
+        solid(floor(), [1.0; 3], Material::MATTE),
+    ]);
+    let up: Vec<Vec3> = floor().positions().iter().map(|p| *p + Vec3::Y).collect();
+    s.set_mesh_positions(1, &up).unwrap();
+    assert_eq!((s.refits(), s.rebuilds()), (1, 0));
+    let st = settings(vec![Light::Ambient { color: [1.0; 3] }]);
+    assert_eq!(render(&s, down_at(0.0, 0.0), st.clone(), 1).0.get(0, 0).unwrap().depth, 4.0);
+    let mut nan = up.clone();
+    nan[3].x = f32::INFINITY;
+    assert!(matches!(
+        s.set_mesh_positions(1, &nan),
+        Err(SceneError::Build {
+            kind: "mesh",
+            object: 1,
+            error: rt_accel::BuildError::NonFiniteVertex { vertex: 3 }
+        })
+    ));
+    assert_eq!(s.set_mesh_positions(7, &up), Err(SceneError::NoSuchMesh(7)));
+    // New topology is a rebuild.
+    let tri = TriangleMesh::new(up[..3].to_vec(), vec![[0, 1, 2]], None).unwrap();
+    s.replace_mesh(1, tri).unwrap();
+    assert_eq!((s.refits(), s.rebuilds(), s.triangle_count()), (1, 1, 3));
+}
