@@ -6,6 +6,7 @@
 //! cargo run --release -p rt-benches --bin rt-report -- grin [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- octree [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- schlieren [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- render [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- all [--quick]
 //! ```
 // A std-only tool crate: the no_std import lints guard the libraries.
@@ -15,6 +16,7 @@
 mod embree3;
 mod grin;
 mod octree;
+mod render;
 mod schlieren;
 mod timing;
 #[cfg(feature = "tinybvh")]
@@ -38,7 +40,7 @@ fn main() -> ExitCode {
     let areas: Vec<&str> =
         args.iter().filter(|a| !a.starts_with("--")).map(String::as_str).collect();
     let areas = if areas.is_empty() || areas == ["all"] {
-        vec!["traversal", "grin", "octree", "schlieren"]
+        vec!["traversal", "grin", "octree", "schlieren", "render"]
     } else {
         areas
     };
@@ -53,8 +55,9 @@ fn main() -> ExitCode {
             "grin" => grin::run(&dir, quick),
             "octree" => octree::run(&dir, quick),
             "schlieren" => schlieren::run(&dir, quick),
+            "render" => render::run(&dir, quick),
             other => Err(format!(
-                "unknown area `{other}` (known: traversal, grin, octree, schlieren, all)"
+                "unknown area `{other}` (known: traversal, grin, octree, schlieren, render, all)"
             )),
         };
         if let Err(e) = result {
