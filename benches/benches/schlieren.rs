@@ -7,27 +7,15 @@
 #![allow(missing_docs)]
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use rt_benches::scenes::sparse_bumps;
-use rt_photo::{Bench, Cutoff, Film, Filter, Mode, Weighting};
-use rt_volume::{Method, TraceParams, build_octree, glam::DVec3, trace};
+use rt_benches::scenes::{knife_bench, sparse_bumps};
+use rt_photo::{Film, Filter};
+use rt_volume::{Method, TraceParams, build_octree, trace};
 
 fn schlieren(c: &mut Criterion) {
     let f = sparse_bumps();
     let tree = build_octree(&f).expect("octree");
     let h = f.grid().spacing().x;
     let rt = TraceParams::for_grid(&f);
-    let bench = |params| Bench {
-        center: DVec3::new(0.5, 0.5, -0.1),
-        direction: DVec3::Z,
-        u: DVec3::X,
-        width: 1.0,
-        height: 1.0,
-        film_distance: 0.0,
-        mode: Mode::Schlieren(Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.0, h: 4e-3 }),
-        weighting: Weighting::Weight,
-        strata: 1,
-        params,
-    };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
     let mut g = c.benchmark_group("schlieren_sparse128_1thread");
     g.sample_size(10).throughput(Throughput::Elements(128 * 128));
@@ -36,7 +24,7 @@ fn schlieren(c: &mut Criterion) {
         ("rt", rt),
         ("rt-2voxel", TraceParams { step: 2.0 * h, max_step: 2.0 * h, ..rt }),
     ] {
-        let b = bench(params);
+        let b = knife_bench(params, 1);
         g.bench_function(name, |bn| {
             bn.iter(|| {
                 let mut film = Film::new(128, 128, Filter::Box).expect("film");

@@ -2,7 +2,8 @@
 
 use glam::Vec3;
 use rt_core::{Camera, Projection, Ray, glam::Vec2, sampling};
-use rt_volume::{Grid, GridField, Interp, glam::DVec3};
+use rt_photo::{Bench, Cutoff, Mode, Weighting};
+use rt_volume::{Grid, GridField, Interp, TraceParams, glam::DVec3};
 
 /// An indexed triangle mesh.
 #[derive(Clone, Debug, Default)]
@@ -166,4 +167,22 @@ pub fn dense_bumps() -> GridField {
         })
         .collect();
     bump_grid(&bumps)
+}
+
+/// The schlieren report's bench: a knife edge (f/h = 250) on a beam along
+/// z over the unit square, `strata²` photons per pixel.
+#[must_use]
+pub fn knife_bench(params: TraceParams, strata: u32) -> Bench {
+    Bench {
+        center: DVec3::new(0.5, 0.5, -0.1),
+        direction: DVec3::Z,
+        u: DVec3::X,
+        width: 1.0,
+        height: 1.0,
+        film_distance: 0.0,
+        mode: Mode::Schlieren(Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.0, h: 4e-3 }),
+        weighting: Weighting::Weight,
+        strata,
+        params,
+    }
 }

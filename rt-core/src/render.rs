@@ -287,24 +287,25 @@ impl Renderer {
     /// [`RenderError::Frame`] for an image too large.
     pub fn new(camera: Camera, settings: Settings) -> Result<Self, RenderError> {
         settings.validate()?;
-        // The frame's own checks (size, allocation) guard the buffers.
-        let frame = Frame::new(camera.width, camera.height).map_err(RenderError::Frame)?;
-        let n = frame.pixels().len();
-        drop(frame);
+        let n = u64::from(camera.width) * u64::from(camera.height);
+        if n > Frame::MAX_PIXELS {
+            return Err(RenderError::Frame(FrameError::TooLarge));
+        }
+        let n = n as usize;
+        let mut sums = Vec::new();
+        let mut depth = Vec::new();
+        let oom = |_| RenderError::Frame(FrameError::OutOfMemory);
+        sums.try_reserve_exact(n).map_err(oom)?;
+        depth.try_reserve_exact(n).map_err(oom)?;
+        sums.resize(n, [0.0; 4]);
+        depth.resize(n, f32::INFINITY);
         let mut settings = settings;
         for l in &mut settings.lights {
             if let Light::Directional { direction, .. } = l {
                 *direction = direction.normalize();
             }
         }
-        Ok(Self {
-            camera,
-            settings,
-            sums: alloc::vec![[0.0; 4]; n],
-            depth: alloc::vec![f32::INFINITY; n],
-            passes: 0,
-            counts: RayCounts::default(),
-        })
+        Ok(Self { camera, settings, sums, depth, passes: 0, counts: RayCounts::default() })
     }
 
     /// Passes accumulated so far.

@@ -207,15 +207,8 @@ pub fn trace_beam(
     };
     check_params(params)?;
     let d = mask.direction;
-    let mut stats = TraceStats::default();
     let Some((t0, t1)) = bounds.clip(origin, d) else {
-        return Ok(TraceResult {
-            position: origin,
-            direction: d,
-            optical_path: 0.0,
-            exit: Exit::Missed,
-            stats,
-        });
+        return Ok(TraceResult::missed(origin, d));
     };
     let x0 = origin + t0 * d;
     let x1 = (origin + t1 * d).clamp(bounds.min, bounds.max);
@@ -229,10 +222,13 @@ pub fn trace_beam(
     };
     let (n0, n1) = (n(x0)?, n(x1)?);
     let len = t1 - t0;
-    stats.steps = 1;
-    stats.skipped = 1;
-    stats.field_evals = 2;
-    stats.skip_bound = grad * len / mask.n_min;
+    let stats = TraceStats {
+        steps: 1,
+        skipped: 1,
+        field_evals: 2,
+        skip_bound: grad * len / mask.n_min,
+        ..TraceStats::default()
+    };
     Ok(TraceResult {
         position: x1,
         direction: d,

@@ -142,6 +142,19 @@ pub struct TraceResult {
     pub stats: TraceStats,
 }
 
+impl TraceResult {
+    /// A ray that never entered the bounds: straight, nothing done.
+    pub(crate) fn missed(origin: DVec3, direction: DVec3) -> Self {
+        Self {
+            position: origin,
+            direction,
+            optical_path: 0.0,
+            exit: Exit::Missed,
+            stats: TraceStats::default(),
+        }
+    }
+}
+
 /// Why a ray could not be traced.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum TraceError {
@@ -295,13 +308,7 @@ pub(crate) fn trace_impl<F: IndexField>(
     let mut ev = Eval { field, bounds, ambient, evals: 0, last: None };
     let mut stats = TraceStats::default();
     let Some((t0, _)) = bounds.clip(origin, d) else {
-        return Ok(TraceResult {
-            position: origin,
-            direction: d,
-            optical_path: 0.0,
-            exit: Exit::Missed,
-            stats,
-        });
+        return Ok(TraceResult::missed(origin, d));
     };
     // Straight through the ambient medium to the entry point.
     let x0 = origin + t0 * d;

@@ -6,32 +6,16 @@
 
 use std::{fmt::Write as _, path::Path};
 
-use glam::DVec3;
 use rt_benches::{
     plot::{PALETTE, Series, loglog},
-    scenes::sparse_bumps,
+    scenes::{knife_bench, sparse_bumps},
 };
-use rt_photo::{Bench, Cutoff, Film, Filter, Mode, Weighting};
+use rt_photo::{Film, Filter};
 use rt_volume::{Method, TraceParams, build_octree, trace, trace_skipping};
 
 use crate::timing::time;
 
 const FILM: usize = 128;
-
-fn bench(params: TraceParams, strata: u32) -> Bench {
-    Bench {
-        center: DVec3::new(0.5, 0.5, -0.1),
-        direction: DVec3::Z,
-        u: DVec3::X,
-        width: 1.0,
-        height: 1.0,
-        film_distance: 0.0,
-        mode: Mode::Schlieren(Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.0, h: 4e-3 }),
-        weighting: Weighting::Weight,
-        strata,
-        params,
-    }
-}
 
 fn rmse(a: &Film, b: &Film) -> f64 {
     let (x, y) = (a.normalized(), b.normalized());
@@ -46,7 +30,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
     // Converged reference: RK4 at a quarter voxel, 256 photons per pixel,
     // skipping only where the per-node deflection bound is below 1e-9.
     let mut reference = Film::new(FILM, FILM, Filter::Box).map_err(str::to_string)?;
-    let rb = bench(TraceParams::fixed(Method::Rk4, 0.25 * h), 16);
+    let rb = knife_bench(TraceParams::fixed(Method::Rk4, 0.25 * h), 16);
     rb.render_with(
         &|o, d| trace_skipping(&f, &tree, o, d, &rb.params, 1e-9),
         &mut reference,
@@ -66,7 +50,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
     for &k in strata {
         for (name, params) in runs {
             // Best of 3 (the film of the last run is kept; all are equal).
-            let b = bench(params, k);
+            let b = knife_bench(params, k);
             let mut secs = f64::INFINITY;
             let mut film = Film::new(FILM, FILM, Filter::Box).map_err(str::to_string)?;
             for _ in 0..3 {
