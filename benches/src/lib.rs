@@ -5,4 +5,5 @@
 
 pub mod image;
 pub mod plot;
+pub mod ply;
 pub mod scenes;

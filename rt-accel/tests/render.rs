@@ -353,15 +353,34 @@ fn frames_are_identical_at_any_thread_count() {
             (f, r.counts())
         })
     };
+    let same = |a: &Frame, b: &Frame| {
+        a.pixels().iter().zip(b.pixels()).all(|(a, b)| {
+            a.color.map(f32::to_bits) == b.color.map(f32::to_bits)
+                && a.depth.to_bits() == b.depth.to_bits()
+        })
+    };
     let (one, c1) = run(1);
     for t in [2, 5] {
         let (f, c) = run(t);
         assert_eq!(c, c1);
-        assert!(one.pixels().iter().zip(f.pixels()).all(|(a, b)| {
-            a.color.map(f32::to_bits) == b.color.map(f32::to_bits)
-                && a.depth.to_bits() == b.depth.to_bits()
-        }));
+        assert!(same(&one, &f));
     }
+    // Progress reports: each tile once per pass, counting up to the total,
+    // and the image is the same.
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(5).build().unwrap();
+    let mut r = Renderer::new(view(), st.clone()).unwrap();
+    let tiles = r.tiles_per_pass();
+    assert_eq!(tiles, 3 * 2);
+    for _ in 0..3 {
+        let seen = std::sync::Mutex::new(Vec::new());
+        pool.install(|| {
+            r.render_pass_with_progress(&s, |done, total| seen.lock().unwrap().push((done, total)))
+        });
+        let mut seen = seen.into_inner().unwrap();
+        seen.sort_unstable();
+        assert_eq!(seen, (1..=tiles).map(|d| (d, tiles)).collect::<Vec<_>>());
+    }
+    assert!(same(&one, &r.frame().unwrap()));
 }
 
 #[test]

@@ -13,7 +13,10 @@
 //! scene's bounds is not traversed ([`RayCounts::culled`]).
 
 use alloc::vec::Vec;
-use core::fmt;
+use core::{
+    fmt,
+    sync::atomic::{AtomicUsize, Ordering},
+};
 
 use glam::{Vec2, Vec3};
 
@@ -336,6 +339,23 @@ impl Renderer {
 
     /// Renders one more pass of `scene`; returns the rays it cast.
     pub fn render_pass<S: ShadeScene + Sync>(&mut self, scene: &S) -> RayCounts {
+        self.render_pass_with_progress(scene, |_, _| {})
+    }
+
+    /// Tiles (16 × 16 pixels, clipped at the edges) in one pass.
+    #[must_use]
+    pub fn tiles_per_pass(&self) -> usize {
+        self.camera.width.div_ceil(TILE) as usize * self.camera.height.div_ceil(TILE) as usize
+    }
+
+    /// [`Self::render_pass`], calling `progress(done, total)` after each
+    /// tile (from the worker threads, in completion order) for progress
+    /// bars. The image does not depend on it.
+    pub fn render_pass_with_progress<S, P>(&mut self, scene: &S, progress: P) -> RayCounts
+    where
+        S: ShadeScene + Sync,
+        P: Fn(usize, usize) + Sync,
+    {
         let (w, h) = (self.camera.width, self.camera.height);
         let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
             .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
@@ -343,7 +363,12 @@ impl Renderer {
         let ctx =
             Ctx { scene, camera: &self.camera, settings: &self.settings, bounds: scene.bounds() };
         let pass = self.passes;
-        let work = |&(x0, y0): &(u32, u32)| ctx.tile(x0, y0, pass);
+        let finished = AtomicUsize::new(0);
+        let work = |&(x0, y0): &(u32, u32)| {
+            let tile = ctx.tile(x0, y0, pass);
+            progress(finished.fetch_add(1, Ordering::Relaxed) + 1, tiles.len());
+            tile
+        };
         #[cfg(feature = "parallel")]
         let done: Vec<TileResult> = {
             use rayon::prelude::*;

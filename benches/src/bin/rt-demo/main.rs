@@ -12,6 +12,8 @@
 //!   cool-to-warm map, and a glossy streamline tube, under ambient light
 //!   with ambient occlusion (8 rays) and a directional light with hard
 //!   shadows; 4 progressive passes.
+//! - `terrain.ply`: the terrain mesh with its `height` scalar, to try the
+//!   `view` example on (`--scalar height`).
 //! - From the built-in blast wave (`benches/data/`, a real PyClaw Euler
 //!   solution, density → index by Gladstone–Dale), photons traced through
 //!   the volume along z: `schlieren-knife.png` (vertical knife edge,
@@ -28,7 +30,7 @@ use std::{path::PathBuf, process::ExitCode, time::Instant};
 
 use glam::Vec3;
 use rt_accel::{BuildParams, Glyphs, Paint, SurfaceScene, TriangleMesh, Tube};
-use rt_benches::{image::write_png, scenes};
+use rt_benches::{image::write_png, ply::write_ply, scenes};
 use rt_core::{
     Camera, ColorMap, Light, Material, Projection, Renderer, Settings, intersect::Sphere,
 };
@@ -38,12 +40,16 @@ const HEIGHT: u32 = 640;
 /// Progressive passes (jittered anti-aliasing, fresh AO directions).
 const PASSES: u32 = 4;
 
-fn build_world() -> Result<SurfaceScene<'static>, String> {
+/// The terrain coloured by its height.
+fn terrain() -> Result<TriangleMesh, String> {
     let terrain = scenes::terrain(257);
     let heights: Vec<f32> = terrain.positions.iter().map(|p| p.y).collect();
+    TriangleMesh::new(terrain.positions, terrain.indices, Some(heights)).map_err(|e| e.to_string())
+}
+
+fn build_world(mesh: TriangleMesh) -> Result<SurfaceScene<'static>, String> {
+    let heights = mesh.scalars().unwrap_or_default();
     let (lo, hi) = heights.iter().fold((f32::MAX, f32::MIN), |(a, b), &h| (a.min(h), b.max(h)));
-    let mesh = TriangleMesh::new(terrain.positions, terrain.indices, Some(heights))
-        .map_err(|e| e.to_string())?;
     // A ring of glyphs above the terrain, sized and coloured by a scalar.
     let spheres: Vec<Sphere> = (0..24)
         .map(|i| {
@@ -99,8 +105,11 @@ fn main() -> ExitCode {
 
 fn run(out: &std::path::Path) -> Result<(), String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let mesh = terrain()?;
+    // The terrain as a file, to try the `view` example on.
+    write_ply(&mesh, "height", &out.join("terrain.ply"))?;
     let t0 = Instant::now();
-    let world = build_world()?;
+    let world = build_world(mesh)?;
     let built = t0.elapsed();
     let proj = Projection::Perspective { fov_y: 40f32.to_radians() };
     let cam = Camera::look_at(

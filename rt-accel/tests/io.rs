@@ -1,0 +1,251 @@
+//! Mesh readers: each format read from hand-written files whose contents
+//! are known exactly, and every kind of bad file an `Err`.
+
+use glam::Vec3;
+use rt_accel::{
+    BuildError,
+    io::{ReadError, parse_obj, parse_ply, parse_vtk_legacy, parse_vtk_xml, read_mesh},
+};
+
+/// A unit square in z = 0 split into two triangles along (0,0)–(1,1), the
+/// scalar equal to x + 2y, normals +z: what every fixture below describes.
+fn square_positions() -> Vec<Vec3> {
+    vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y]
+}
+
+const QUAD: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
+
+#[test]
+fn obj_polygons_become_fans_with_normals_and_texture_scalars() {
+    let obj = b"# a square\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+                vt 0 0.5\nvt 1 0.5\nvt 3 0.5\nvt 2 0.5\nvn 0 0 1\n\
+                f 1/1/1 2/2/1 3/3/1 4/4/1\n";
+    let data = parse_obj(obj).unwrap();
+    assert_eq!(data.positions, square_positions());
+    assert_eq!(data.indices, QUAD);
+    assert_eq!(data.normals.as_deref(), Some(&[Vec3::Z; 4][..]));
+    assert_eq!(data.scalar_names().collect::<Vec<_>>(), ["u", "v"]);
+    let mesh = data.into_mesh(Some("u")).unwrap();
+    assert_eq!(mesh.scalars(), Some(&[0.0, 1.0, 3.0, 2.0][..]));
+    assert!(mesh.normals().is_some());
+}
+
+#[test]
+fn obj_objects_are_merged_with_shifted_indices() {
+    let obj = b"o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n\
+                o b\nv 5 0 0\nv 6 0 0\nv 5 1 0\nf 4 5 6\nl 4 5\np 6\n";
+    let data = parse_obj(obj).unwrap();
+    assert_eq!(data.positions.len(), 6);
+    assert_eq!(data.indices, [[0, 1, 2], [3, 4, 5]]);
+    assert_eq!(data.positions[3], Vec3::new(5.0, 0.0, 0.0));
+    assert!(data.normals.is_none());
+    assert!(data.scalars.is_empty());
+}
+
+fn ply_header(format: &str, extra: &str) -> String {
+    format!(
+        "ply\nformat {format} 1.0\ncomment made by hand\nelement vertex 4\n\
+         property float x\nproperty float y\nproperty float z\n\
+         property float nx\nproperty float ny\nproperty float nz\n\
+         property double pressure\nproperty uchar flag\n{extra}\
+         element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+}
+
+#[test]
+fn ply_ascii_and_binary_read_the_same_mesh() {
+    let mut ascii = ply_header("ascii", "");
+    for p in square_positions() {
+        ascii += &format!("{} {} {} 0 0 1 {} 7\n", p.x, p.y, p.z, p.x + 2.0 * p.y);
+    }
+    ascii += "4 0 1 2 3\n";
+    let from_ascii = parse_ply(ascii.as_bytes()).unwrap();
+
+    for big in [false, true] {
+        let fmt = if big { "binary_big_endian" } else { "binary_little_endian" };
+        let mut bin = ply_header(fmt, "").into_bytes();
+        let f = |v: f32| if big { v.to_be_bytes() } else { v.to_le_bytes() };
+        for p in square_positions() {
+            for v in [p.x, p.y, p.z, 0.0, 0.0, 1.0] {
+                bin.extend(f(v));
+            }
+            let s = f64::from(p.x + 2.0 * p.y);
+            bin.extend(if big { s.to_be_bytes() } else { s.to_le_bytes() });
+            bin.push(7);
+        }
+        bin.push(4);
+        for i in 0i32..4 {
+            bin.extend(if big { i.to_be_bytes() } else { i.to_le_bytes() });
+        }
+        assert_eq!(parse_ply(&bin).unwrap(), from_ascii, "{fmt}");
+    }
+
+    assert_eq!(from_ascii.positions, square_positions());
+    assert_eq!(from_ascii.indices, QUAD);
+    assert_eq!(from_ascii.normals.as_deref(), Some(&[Vec3::Z; 4][..]));
+    assert_eq!(from_ascii.scalar_names().collect::<Vec<_>>(), ["pressure", "flag"]);
+    let mesh = from_ascii.into_mesh(Some("pressure")).unwrap();
+    assert_eq!(mesh.scalars(), Some(&[0.0, 1.0, 3.0, 2.0][..]));
+}
+
+#[test]
+fn vtk_legacy_polydata_polygons_strips_and_point_data() {
+    let vtk = b"# vtk DataFile Version 3.0\nsquare\nASCII\nDATASET POLYDATA\n\
+        POINTS 6 float\n0 0 0  1 0 0  1 1 0  0 1 0  2 0 0  2 1 0\n\
+        POLYGONS 1 5\n4 0 1 2 3\n\
+        TRIANGLE_STRIPS 1 5\n4 1 4 2 5\n\
+        POINT_DATA 6\nSCALARS pressure float 1\nLOOKUP_TABLE default\n0 1 3 2 2 4\n\
+        VECTORS velocity float\n3 4 0  0 0 0  1 0 0  0 1 0  0 0 2  6 8 0\n\
+        NORMALS normals float\n0 0 1  0 0 1  0 0 1  0 0 1  0 0 1  0 0 1\n";
+    let data = parse_vtk_legacy(vtk).unwrap();
+    assert_eq!(data.positions.len(), 6);
+    // The fan, then the strip with every other triangle turned to keep
+    // the winding: (1,4,2), (4,2,5) → (2,4,5).
+    assert_eq!(data.indices, [[0, 1, 2], [0, 2, 3], [1, 4, 2], [2, 4, 5]]);
+    for t in &data.indices {
+        let [a, b, c] = t.map(|i| data.positions[i as usize]);
+        assert!((b - a).cross(c - a).z > 0.0, "{t:?} is wound clockwise");
+    }
+    assert_eq!(data.normals.as_deref(), Some(&[Vec3::Z; 6][..]));
+    assert_eq!(data.scalar_names().collect::<Vec<_>>(), ["pressure", "velocity"]);
+    let speed = data.clone().into_mesh(Some("velocity")).unwrap();
+    assert_eq!(speed.scalars(), Some(&[5.0, 0.0, 1.0, 1.0, 2.0, 10.0][..]));
+    let p = data.into_mesh(Some("pressure")).unwrap();
+    assert_eq!(p.scalars(), Some(&[0.0, 1.0, 3.0, 2.0, 2.0, 4.0][..]));
+}
+
+#[test]
+fn vtk_xml_polydata() {
+    let vtp = br#"<?xml version="1.0"?>
+<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">
+  <PolyData>
+    <Piece NumberOfPoints="4" NumberOfVerts="0" NumberOfLines="0" NumberOfStrips="0" NumberOfPolys="1">
+      <PointData Scalars="pressure">
+        <DataArray type="Float32" Name="pressure" format="ascii">0 1 3 2</DataArray>
+      </PointData>
+      <Points>
+        <DataArray type="Float32" NumberOfComponents="3" format="ascii">0 0 0 1 0 0 1 1 0 0 1 0</DataArray>
+      </Points>
+      <Polys>
+        <DataArray type="Int32" Name="connectivity" format="ascii">0 1 2 3</DataArray>
+        <DataArray type="Int32" Name="offsets" format="ascii">4</DataArray>
+      </Polys>
+    </Piece>
+  </PolyData>
+</VTKFile>
+"#;
+    let data = parse_vtk_xml(vtp).unwrap();
+    assert_eq!(data.positions, square_positions());
+    assert_eq!(data.indices, QUAD);
+    let mesh = data.into_mesh(Some("pressure")).unwrap();
+    assert_eq!(mesh.scalars(), Some(&[0.0, 1.0, 3.0, 2.0][..]));
+}
+
+#[test]
+fn read_mesh_goes_by_extension_and_names_io_errors() {
+    let dir = std::env::temp_dir().join(format!("rt-accel-io-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let obj = dir.join("t.OBJ");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    assert_eq!(read_mesh(&obj).unwrap().indices, [[0, 1, 2]]);
+    let missing = dir.join("none.ply");
+    match read_mesh(&missing) {
+        Err(ReadError::Io { path, .. }) => assert!(path.ends_with("none.ply")),
+        other => panic!("{other:?}"),
+    }
+    assert!(matches!(read_mesh(&dir.join("t.stl")), Err(ReadError::Unsupported(_))));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_geometry_names_the_vertex_or_triangle() {
+    let nan = parse_obj(b"v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    assert_eq!(
+        nan.into_mesh(None),
+        Err(ReadError::Mesh(BuildError::NonFiniteVertex { vertex: 1 }))
+    );
+
+    let mut ply = ply_header("ascii", "");
+    ply += "0 0 0 0 0 1 0 0\n1 0 0 0 0 1 0 0\n0 1 0 0 0 1 0 0\n0 0 1 0 0 0 0 0\n3 0 1 2\n";
+    // Vertex 3's normal is zero.
+    let data = parse_ply(ply.as_bytes()).unwrap();
+    assert_eq!(data.into_mesh(None), Err(ReadError::Mesh(BuildError::BadNormal { vertex: 3 })));
+
+    let far = ply.replace("3 0 1 2\n", "3 0 1 9\n");
+    let data = parse_ply(far.as_bytes()).unwrap();
+    assert_eq!(
+        data.into_mesh(None),
+        Err(ReadError::Mesh(BuildError::IndexOutOfRange { triangle: 0, index: 9 }))
+    );
+
+    // An index past its own object must not land on the next object's
+    // vertices once the objects are merged.
+    let vtk = b"# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\n\
+        POINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0 1 3\n";
+    assert_eq!(
+        parse_vtk_legacy(vtk),
+        Err(ReadError::Mesh(BuildError::IndexOutOfRange { triangle: 0, index: 3 }))
+    );
+}
+
+#[test]
+fn missing_scalar_lists_the_available_ones() {
+    let data =
+        parse_obj(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n").unwrap();
+    match data.into_mesh(Some("temperature")) {
+        Err(ReadError::NoSuchScalar { name, available }) => {
+            assert_eq!(name, "temperature");
+            assert_eq!(available, ["u", "v"]);
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn malformed_files_are_errors() {
+    let mut ply = ply_header("ascii", "");
+    ply += "0 0 0 0 0 1 0 0\n1 0 0 0 0 1 0 0\n0 1 0 0 0 1 0 0\n0 0 1 0 0 1 0 0\n3 0 1 2\n";
+    let truncated_binary = {
+        let mut b = ply_header("binary_little_endian", "").into_bytes();
+        b.extend([0u8; 40]);
+        b
+    };
+    let cases: Vec<(&str, Result<_, ReadError>)> = vec![
+        ("obj face index 0", parse_obj(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n")),
+        ("obj face past the end", parse_obj(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n")),
+        ("obj bad number", parse_obj(b"v 0 zero 0\n")),
+        ("not a ply", parse_ply(b"plx\nformat ascii 1.0\nend_header\n")),
+        ("ply without end_header", parse_ply(b"ply\nformat ascii 1.0\nelement vertex 1\n")),
+        ("ply truncated ascii", parse_ply(ply.replace("3 0 1 2\n", "").as_bytes())),
+        ("ply truncated binary", parse_ply(&truncated_binary)),
+        ("ply two-vertex face", parse_ply(ply.replace("3 0 1 2\n", "2 0 1\n").as_bytes())),
+        ("ply negative index", parse_ply(ply.replace("3 0 1 2\n", "3 0 -1 2\n").as_bytes())),
+        (
+            "ply without z",
+            parse_ply(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n"),
+        ),
+        ("ply huge count", parse_ply(b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n\0\0")),
+        ("vtk garbage", parse_vtk_legacy(b"# vtk DataFile Version 3.0\n\xff\xfe")),
+        (
+            "vtk image data",
+            parse_vtk_legacy(b"# vtk DataFile Version 3.0\nx\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 1 1 1\nORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 1\nSCALARS s float 1\nLOOKUP_TABLE default\n0\n"),
+        ),
+        (
+            "vtk polygon runs past its data",
+            parse_vtk_legacy(b"# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n9 0 1 2\n"),
+        ),
+        (
+            "vtk two-point polygon",
+            parse_vtk_legacy(b"# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 3\n2 0 1\n"),
+        ),
+        ("vtp garbage", parse_vtk_xml(b"<VTKFile type=\"PolyData\"><PolyData><Piece")),
+    ];
+    let accepted: Vec<_> = cases.iter().filter(|(_, r)| r.is_ok()).collect();
+    assert!(accepted.is_empty(), "accepted: {accepted:?}");
+    for (what, result) in cases {
+        // Every error explains itself.
+        assert!(!result.unwrap_err().to_string().is_empty(), "{what}");
+    }
+    // An empty file is a valid, empty mesh.
+    assert_eq!(parse_obj(b"").unwrap(), rt_accel::io::MeshData::default());
+}
