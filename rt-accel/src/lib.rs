@@ -21,7 +21,7 @@
 //! | `std` | yes | std float functions; implies `alloc` |
 //! | `alloc` | via `std` | owned [`Bvh`], [`Scene`], [`TriangleMesh`], copying loader, refit |
 //! | `obvhs` | yes | building ([`build_triangles`], [`build_spheres`], [`build_capsules`], [`SurfaceScene`]); needs std |
-//! | `io` | no | mesh readers ([`io`]): OBJ, PLY with scalars, VTK polydata; needs std |
+//! | `io` | no | mesh readers (module `io`): OBJ, PLY with scalars, VTK polydata; needs std |
 //! | `libm` | no | float functions from `libm` for `no_std` |
 //!
 //! ## Example
