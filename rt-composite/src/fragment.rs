@@ -66,12 +66,31 @@ impl Fragment for Pixel {
     const SIZE: usize = 20;
 
     fn is_background(&self) -> bool {
-        self.depth.to_bits() == f32::INFINITY.to_bits()
-            && self.color.iter().all(|c| c.to_bits() == 0)
+        // Bitwise, without early exits: compositing loops stay branch-free.
+        let c = self.color.map(f32::to_bits);
+        ((self.depth.to_bits() ^ f32::INFINITY.to_bits()) | c[0] | c[1] | c[2] | c[3]) == 0
     }
 
     fn depth(&self) -> f32 {
         depth_key(self.depth)
+    }
+
+    /// As the trait's, as a bitwise select (depths of real images are
+    /// unpredictable, and a branch per pixel costs more than the select).
+    fn z(self, back: Self) -> Self {
+        let take_back =
+            !back.is_background() & (self.is_background() | (back.depth() < self.depth()));
+        let m = 0u32.wrapping_sub(u32::from(take_back));
+        let pick = |a: f32, b: f32| f32::from_bits((b.to_bits() & m) | (a.to_bits() & !m));
+        Self {
+            color: [
+                pick(self.color[0], back.color[0]),
+                pick(self.color[1], back.color[1]),
+                pick(self.color[2], back.color[2]),
+                pick(self.color[3], back.color[3]),
+            ],
+            depth: pick(self.depth, back.depth),
+        }
     }
 
     fn over(self, back: Self) -> Self {

@@ -7,11 +7,13 @@
 //! cargo run --release -p rt-benches --bin rt-report -- octree [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- schlieren [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- render [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- composite [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- all [--quick]
 //! ```
 // A std-only tool crate: the no_std import lints guard the libraries.
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
+mod composite;
 #[cfg(feature = "embree3")]
 mod embree3;
 mod grin;
@@ -40,7 +42,7 @@ fn main() -> ExitCode {
     let areas: Vec<&str> =
         args.iter().filter(|a| !a.starts_with("--")).map(String::as_str).collect();
     let areas = if areas.is_empty() || areas == ["all"] {
-        vec!["traversal", "grin", "octree", "schlieren", "render"]
+        vec!["traversal", "grin", "octree", "schlieren", "render", "composite"]
     } else {
         areas
     };
@@ -56,8 +58,9 @@ fn main() -> ExitCode {
             "octree" => octree::run(&dir, quick),
             "schlieren" => schlieren::run(&dir, quick),
             "render" => render::run(&dir, quick),
+            "composite" => composite::run(&dir, quick),
             other => Err(format!(
-                "unknown area `{other}` (known: traversal, grin, octree, schlieren, render, all)"
+                "unknown area `{other}` (known: traversal, grin, octree, schlieren, render, composite, all)"
             )),
         };
         if let Err(e) = result {
