@@ -341,26 +341,20 @@ pub fn composite<C: Communicator, F: Fragment>(
     {
         run.fail(CompositeError::BadRadix(k));
     }
-    // Virtual ranks: visibility positions for `over`, ranks for depth.
-    let position: Vec<usize> = match mode {
-        Mode::Depth => (0..n).collect(),
-        Mode::Over { order } => {
-            if check_order(order, n).is_err() {
-                run.fail(CompositeError::BadOrder);
-                (0..n).collect()
-            } else {
-                let mut pos = vec![0; n];
-                for (i, &r) in order.iter().enumerate() {
-                    pos[r] = i;
-                }
-                pos
-            }
+    // Virtual ranks: visibility positions for `over`, ranks for depth;
+    // `order[v]` is the rank at virtual index `v`.
+    let order: Vec<usize> = match mode {
+        Mode::Over { order } if check_order(order, n).is_ok() => order.clone(),
+        Mode::Over { .. } => {
+            run.fail(CompositeError::BadOrder);
+            (0..n).collect()
         }
+        Mode::Depth => (0..n).collect(),
     };
     if matches!(mode, Mode::Over { .. }) && schedule != Schedule::DirectSend && n > 1 {
         run.fail(CompositeError::OverNeedsDirectSend);
     }
-    let at = |v: usize| position.iter().position(|&p| p == v).unwrap_or(v);
+    let at = |v: usize| order[v];
     let op = |a: F, b: F| combine(mode, a, b);
     let mut span = 0..total;
     let mut data = if run.error.is_none() {
@@ -370,7 +364,7 @@ pub fn composite<C: Communicator, F: Fragment>(
     };
 
     // Binary swap on 2^m + e ranks: the first 2e fold pairwise.
-    let me = position[rank];
+    let me = order.iter().position(|&r| r == rank).unwrap_or(rank);
     let (mut v, count) = if schedule == Schedule::BinarySwap {
         let p = 1 << n.ilog2();
         let e = n - p;
