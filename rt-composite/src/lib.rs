@@ -60,9 +60,15 @@ mod fragment;
 mod schedule;
 mod sparse;
 
+#[cfg(feature = "mpi")]
+pub use comm::MpiComm;
 #[cfg(feature = "std")]
 pub use comm::ThreadComm;
 pub use comm::{CommError, Communicator};
 pub use fragment::{Fragment, Pixel8, over, z_composite};
+/// The `mpi` crate (rsmpi) this crate's [`MpiComm`] is built on, so that
+/// callers initialise MPI with the same version.
+#[cfg(feature = "mpi")]
+pub use mpi;
 pub use schedule::{CompositeError, Mode, Schedule, Stats, composite, serial_fold};
 pub use sparse::{DecodeError, SparseImage};

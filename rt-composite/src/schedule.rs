@@ -204,7 +204,9 @@ fn part(range: &Range<usize>, j: usize, k: usize) -> Range<usize> {
 
 const MAGIC: u32 = 0x5254_4331; // "RTC1"
 const HEADER: usize = 13;
-const GATHER_TAG: u32 = 1 << 20;
+// Below 32768, the least tag upper bound MPI guarantees; round tags are
+// `round + 1`, far below.
+const GATHER_TAG: u32 = 0x7000;
 const STATUS_TAG: u32 = GATHER_TAG + 1;
 
 /// A message: magic, flag (0 data, 1 failed), width, height, then the
