@@ -1,5 +1,7 @@
 //! Pixels and the two compositing operators.
 
+use alloc::vec::Vec;
+
 use rt_core::Pixel;
 
 /// A pixel that can be composited: premultiplied RGBA plus depth, with a
@@ -39,6 +41,34 @@ pub trait Fragment: Copy + PartialEq + core::fmt::Debug + Send + Sync + 'static 
     fn write(&self, out: &mut [u8]);
     /// Reads [`Self::SIZE`] bytes.
     fn read(bytes: &[u8]) -> Self;
+    /// Appends the wire form of every pixel of `pixels` to `out` (as
+    /// [`Self::write`] each, in one pass).
+    fn write_all(pixels: &[Self], out: &mut Vec<u8>) {
+        let at = out.len();
+        out.resize(at + Self::SIZE * pixels.len(), 0);
+        for (chunk, p) in out[at..].chunks_exact_mut(Self::SIZE).zip(pixels) {
+            p.write(chunk);
+        }
+    }
+    /// The pixels of `bytes` (whole [`Self::SIZE`] chunks; a partial one at
+    /// the end is left out), as [`Self::read`] each.
+    #[must_use]
+    fn read_all(bytes: &[u8]) -> Vec<Self> {
+        bytes.chunks_exact(Self::SIZE).map(Self::read).collect()
+    }
+}
+
+/// Whole-slice copies where the wire form is the memory layout (the
+/// fields in order, little-endian, no padding).
+#[cfg(target_endian = "little")]
+fn write_pod<T: bytemuck::Pod>(pixels: &[T], out: &mut Vec<u8>) {
+    out.extend_from_slice(bytemuck::cast_slice(pixels));
+}
+
+#[cfg(target_endian = "little")]
+fn read_pod<T: bytemuck::Pod>(bytes: &[u8]) -> Vec<T> {
+    let whole = bytes.len() - bytes.len() % core::mem::size_of::<T>();
+    bytemuck::pod_collect_to_vec(&bytes[..whole])
 }
 
 fn depth_key(d: f32) -> f32 {
@@ -121,11 +151,23 @@ impl Fragment for Pixel {
         };
         Self { color: [f(0), f(1), f(2), f(3)], depth: f(4) }
     }
+
+    // `repr(C)` `[f32; 4]` then `f32`: the wire form on little-endian.
+    #[cfg(target_endian = "little")]
+    fn write_all(pixels: &[Self], out: &mut Vec<u8>) {
+        write_pod(pixels, out);
+    }
+
+    #[cfg(target_endian = "little")]
+    fn read_all(bytes: &[u8]) -> Vec<Self> {
+        read_pod(bytes)
+    }
 }
 
 /// A pixel with 8-bit premultiplied RGBA (a quarter of the colour
 /// bandwidth) and `f32` depth.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub struct Pixel8 {
     /// Premultiplied `[r, g, b, a]`, 255 = 1.
     pub color: [u8; 4],
@@ -193,5 +235,16 @@ impl Fragment for Pixel8 {
             color: [bytes[0], bytes[1], bytes[2], bytes[3]],
             depth_bits: u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]),
         }
+    }
+
+    // `repr(C)` `[u8; 4]` then `u32`: the wire form on little-endian.
+    #[cfg(target_endian = "little")]
+    fn write_all(pixels: &[Self], out: &mut Vec<u8>) {
+        write_pod(pixels, out);
+    }
+
+    #[cfg(target_endian = "little")]
+    fn read_all(bytes: &[u8]) -> Vec<Self> {
+        read_pod(bytes)
     }
 }

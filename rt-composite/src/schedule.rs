@@ -210,15 +210,19 @@ const GATHER_TAG: u32 = 0x7000;
 const STATUS_TAG: u32 = GATHER_TAG + 1;
 
 /// A message: magic, flag (0 data, 1 failed), width, height, then the
-/// sparse image (data only).
-fn message<F: Fragment>(size: (u32, u32), image: Option<&SparseImage<F>>) -> Vec<u8> {
-    let mut out = Vec::with_capacity(HEADER + image.map_or(0, SparseImage::byte_len));
+/// sparse image's part in `range` (data only), serialized straight from
+/// the image.
+fn message<F: Fragment>(
+    size: (u32, u32),
+    image: Option<(&SparseImage<F>, Range<usize>)>,
+) -> Vec<u8> {
+    let mut out = Vec::with_capacity(HEADER);
     out.extend(MAGIC.to_le_bytes());
     out.push(u8::from(image.is_none()));
     out.extend(size.0.to_le_bytes());
     out.extend(size.1.to_le_bytes());
-    if let Some(i) = image {
-        out.extend(i.to_bytes());
+    if let Some((i, range)) = image {
+        i.append_slice_bytes(range, &mut out);
     }
     out
 }
@@ -242,8 +246,16 @@ impl<C: Communicator, F: Fragment> Run<'_, C, F> {
         self.error.get_or_insert(e);
     }
 
-    fn send(&mut self, to: usize, tag: u32, image: Option<&SparseImage<F>>) {
+    /// Sends `image` (its part in the range, when given), or "failed".
+    fn send(
+        &mut self,
+        to: usize,
+        tag: u32,
+        image: Option<&SparseImage<F>>,
+        range: Option<Range<usize>>,
+    ) {
         let image = if self.error.is_some() { None } else { image };
+        let image = image.map(|i| (i, range.unwrap_or_else(|| i.range())));
         let bytes = message(self.size, image);
         self.stats.bytes_sent += bytes.len();
         self.stats.messages += 1;
@@ -372,11 +384,11 @@ pub fn composite<C: Communicator, F: Fragment>(
         let e = n - p;
         if me < 2 * e {
             if me % 2 == 1 {
-                run.send(at(me - 1), 0, Some(&data));
+                run.send(at(me - 1), 0, Some(&data), None);
                 (None, p)
             } else {
                 if let Some(theirs) = run.recv(at(me + 1), 0, Some(&span)) {
-                    data = data.combine(&theirs, op).unwrap_or(theirs); // spans checked on receipt
+                    data = data.combine_owned(&theirs, op).unwrap_or(theirs); // spans checked on receipt
                 }
                 (Some(me / 2), p)
             }
@@ -403,21 +415,21 @@ pub fn composite<C: Communicator, F: Fragment>(
             let digit = (*vr / stride) % k;
             let base = *vr - digit * stride;
             for j in (0..k).filter(|&j| j != digit) {
-                run.send(real(base + j * stride), tag, Some(&data.slice(part(&span, j, k))));
+                run.send(real(base + j * stride), tag, Some(&data), Some(part(&span, j, k)));
             }
             let mine = part(&span, digit, k);
-            let own = data.slice(mine.clone());
+            let mut own = Some(data.slice(mine.clone()));
             let mut acc: Option<SparseImage<F>> = None;
             for j in 0..k {
                 let piece = if j == digit {
-                    Some(own.clone())
+                    own.take()
                 } else {
                     run.recv(real(base + j * stride), tag, Some(&mine))
                 };
                 let piece = piece.unwrap_or_else(|| SparseImage::empty(mine.clone()));
                 acc = Some(match acc {
                     None => piece,
-                    Some(a) => a.combine(&piece, op).unwrap_or(piece), // received spans are checked
+                    Some(a) => a.combine_owned(&piece, op).unwrap_or(piece), // received spans are checked
                 });
             }
             span = mine.clone();
@@ -445,12 +457,12 @@ pub fn composite<C: Communicator, F: Fragment>(
         let ok = run.error.is_none();
         for r in 1..n {
             let status = if ok { Some(SparseImage::empty(0..0)) } else { None };
-            run.send(r, STATUS_TAG, status.as_ref());
+            run.send(r, STATUS_TAG, status.as_ref(), None);
         }
         result = Some(full);
     } else {
         let empty = SparseImage::empty(0..0);
-        run.send(0, GATHER_TAG, Some(if v.is_some() { &data } else { &empty }));
+        run.send(0, GATHER_TAG, Some(if v.is_some() { &data } else { &empty }), None);
         // Wait for the verdict even after a local failure.
         run.comm_failed = false;
         run.recv(0, STATUS_TAG, None);

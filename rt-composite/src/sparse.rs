@@ -55,12 +55,20 @@ impl<F: Fragment> SparseImage<F> {
         s
     }
 
-    /// Encodes `pixels`, the span starting at pixel `start`.
+    /// Encodes `pixels`, the span starting at pixel `start`: active runs
+    /// are copied whole.
     #[must_use]
     pub fn encode(start: usize, pixels: &[F]) -> Self {
-        let mut s = Self::empty(start..start);
-        for p in pixels {
-            s.push(*p);
+        let count = pixels.iter().filter(|p| !p.is_background()).count();
+        let mut s = Self { start, len: 0, runs: Vec::new(), active: Vec::with_capacity(count) };
+        let mut rest = pixels;
+        while !rest.is_empty() {
+            let bg = rest.iter().position(|p| !p.is_background()).unwrap_or(rest.len());
+            s.push_background(bg);
+            rest = &rest[bg..];
+            let active = rest.iter().position(Fragment::is_background).unwrap_or(rest.len());
+            s.push_active_run(&rest[..active]);
+            rest = &rest[active..];
         }
         s
     }
@@ -95,13 +103,30 @@ impl<F: Fragment> SparseImage<F> {
         }
     }
 
-    fn push_active(&mut self, p: F) {
-        self.len += 1;
-        match self.runs.last_mut() {
-            Some((_, a)) if *a < u32::MAX => *a += 1,
-            _ => self.runs.push((0, 1)),
+    /// Counts `n` more active pixels (already stored) in the runs.
+    fn count_active(&mut self, mut n: usize) {
+        self.len += n;
+        while n > 0 {
+            match self.runs.last_mut() {
+                Some((_, a)) if *a < u32::MAX => {
+                    let take = n.min((u32::MAX - *a) as usize);
+                    *a += take as u32;
+                    n -= take;
+                }
+                _ => self.runs.push((0, 0)),
+            }
         }
+    }
+
+    fn push_active(&mut self, p: F) {
         self.active.push(p);
+        self.count_active(1);
+    }
+
+    /// Appends pixels known to be active.
+    fn push_active_run(&mut self, pixels: &[F]) {
+        self.active.extend_from_slice(pixels);
+        self.count_active(pixels.len());
     }
 
     fn push(&mut self, p: F) {
@@ -121,9 +146,19 @@ impl<F: Fragment> SparseImage<F> {
     /// The part of the span in `range` (clipped to the span).
     #[must_use]
     pub fn slice(&self, range: Range<usize>) -> Self {
+        let (mut out, pixels) = self.slice_runs(range);
+        out.active.extend_from_slice(&self.active[pixels]);
+        out
+    }
+
+    /// [`Self::slice`]'s runs with no pixels stored, and the range of
+    /// `self`'s active pixels it holds (the active pixels of a contiguous
+    /// span are contiguous).
+    fn slice_runs(&self, range: Range<usize>) -> (Self, Range<usize>) {
         let lo = range.start.clamp(self.start, self.start + self.len);
         let hi = range.end.clamp(lo, self.start + self.len);
         let mut out = Self::empty(lo..lo);
+        let mut pixels: Option<Range<usize>> = None;
         let mut at = self.start;
         for (n, active) in self.segments() {
             let (a, b) = (at.max(lo), (at + n).min(hi));
@@ -132,9 +167,9 @@ impl<F: Fragment> SparseImage<F> {
                     None => out.push_background(b - a),
                     Some(i) => {
                         let first = i + (a - at);
-                        for p in &self.active[first..first + (b - a)] {
-                            out.push_active(*p);
-                        }
+                        out.count_active(b - a);
+                        let r = pixels.get_or_insert(first..first);
+                        r.end = first + (b - a);
                     }
                 }
             }
@@ -143,7 +178,16 @@ impl<F: Fragment> SparseImage<F> {
                 break;
             }
         }
-        out
+        (out, pixels.unwrap_or(0..0))
+    }
+
+    /// Appends the wire form of `self.slice(range)` to `out`, without
+    /// making the slice.
+    pub fn append_slice_bytes(&self, range: Range<usize>, out: &mut Vec<u8>) {
+        let (runs, pixels) = self.slice_runs(range);
+        out.reserve(runs.byte_len() + F::SIZE * pixels.len());
+        runs.append_header(out);
+        F::write_all(&self.active[pixels], out);
     }
 
     /// `op(self, other)` per pixel over the same span (where only one side
@@ -155,30 +199,56 @@ impl<F: Fragment> SparseImage<F> {
             return None;
         }
         let mut out = Self::empty(self.start..self.start);
+        out.active.reserve_exact((self.active.len() + other.active.len()).min(self.len));
         let (mut a, mut b) = (self.segments(), other.segments());
         let (mut sa, mut sb) = (a.next(), b.next());
         while let (Some((na, ia)), Some((nb, ib))) = (sa, sb) {
             let n = na.min(nb);
             match (ia, ib) {
                 (None, None) => out.push_background(n),
-                (Some(i), None) => {
-                    for p in &self.active[i..i + n] {
-                        out.push_active(*p);
-                    }
-                }
-                (None, Some(j)) => {
-                    for p in &other.active[j..j + n] {
-                        out.push_active(*p);
-                    }
-                }
+                (Some(i), None) => out.push_active_run(&self.active[i..i + n]),
+                (None, Some(j)) => out.push_active_run(&other.active[j..j + n]),
                 (Some(i), Some(j)) => {
-                    for (p, q) in self.active[i..i + n].iter().zip(&other.active[j..j + n]) {
-                        out.push(op(*p, *q));
+                    let from = out.active.len();
+                    let (p, q) = (&self.active[i..i + n], &other.active[j..j + n]);
+                    out.active.extend(p.iter().zip(q).map(|(p, q)| op(*p, *q)));
+                    if out.active[from..].iter().any(Fragment::is_background) {
+                        // An operator gave the background (not z, which
+                        // returns an operand): re-encode this stretch.
+                        for p in out.active.split_off(from) {
+                            out.push(p);
+                        }
+                    } else {
+                        out.count_active(n);
                     }
                 }
             }
             sa = if na > n { Some((na - n, ia.map(|i| i + n))) } else { a.next() };
             sb = if nb > n { Some((nb - n, ib.map(|j| j + n))) } else { b.next() };
+        }
+        Some(out)
+    }
+
+    /// As [`Self::combine`], consuming `self`: where both operands have the
+    /// same runs (dense images, or the same coverage) the result is
+    /// written over `self`'s pixels, with no new storage.
+    pub(crate) fn combine_owned(mut self, other: &Self, op: impl Fn(F, F) -> F) -> Option<Self> {
+        if self.runs != other.runs || self.start != other.start {
+            return self.combine(other, op);
+        }
+        for (p, q) in self.active.iter_mut().zip(&other.active) {
+            *p = op(*p, *q);
+        }
+        if !self.active.iter().any(Fragment::is_background) {
+            return Some(self);
+        }
+        // An operator gave the background somewhere: re-encode.
+        let mut out = Self::empty(self.start..self.start);
+        for (n, active) in self.segments() {
+            match active {
+                None => out.push_background(n),
+                Some(i) => self.active[i..i + n].iter().for_each(|p| out.push(*p)),
+            }
         }
         Some(out)
     }
@@ -211,6 +281,19 @@ impl<F: Fragment> SparseImage<F> {
     #[must_use]
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut out = Vec::with_capacity(self.byte_len());
+        self.append_bytes(&mut out);
+        out
+    }
+
+    /// Appends [`Self::to_bytes`]'s form to `out`.
+    pub fn append_bytes(&self, out: &mut Vec<u8>) {
+        out.reserve(self.byte_len());
+        self.append_header(out);
+        F::write_all(&self.active, out);
+    }
+
+    /// Start, length, run count and runs: the wire form but the pixels.
+    fn append_header(&self, out: &mut Vec<u8>) {
         out.extend((self.start as u64).to_le_bytes());
         out.extend((self.len as u64).to_le_bytes());
         out.extend((self.runs.len() as u32).to_le_bytes());
@@ -218,12 +301,6 @@ impl<F: Fragment> SparseImage<F> {
             out.extend(bg.to_le_bytes());
             out.extend(a.to_le_bytes());
         }
-        let at = out.len();
-        out.resize(at + F::SIZE * self.active.len(), 0);
-        for (chunk, p) in out[at..].chunks_exact_mut(F::SIZE).zip(&self.active) {
-            p.write(chunk);
-        }
-        out
     }
 
     /// Reads [`Self::to_bytes`]'s form, checking every length before
@@ -270,7 +347,7 @@ impl<F: Fragment> SparseImage<F> {
             None => return Err(DecodeError::Truncated),
             Some(_) => {}
         }
-        let active: Vec<F> = bytes[runs_end..].chunks_exact(F::SIZE).map(F::read).collect();
+        let active = F::read_all(&bytes[runs_end..]);
         if active.iter().any(Fragment::is_background) {
             return Err(DecodeError::StoredBackground);
         }

@@ -256,6 +256,37 @@ fn ordered_over_and_eight_bit_pixels_equal_the_serial_fold() {
     }
 }
 
+/// `-0.0` colour at `+∞` over `+0.0` colour at NaN depth is `+0.0` at
+/// `+∞`: the background, made from two active pixels. The result must be
+/// stored as background (the gather's decoder rejects a stored one) and
+/// still equal the serial fold, on both the in-place (same runs) and the
+/// general path.
+#[test]
+fn an_over_that_makes_the_background_is_encoded_as_background() {
+    let a = Pixel { color: [-0.0; 4], depth: f32::INFINITY };
+    let b = Pixel { color: [0.0; 4], depth: f32::NAN };
+    assert!(!a.is_background() && !b.is_background() && a.over(b).is_background());
+    let c = Pixel { color: [0.5; 4], depth: 1.0 };
+    for images in [
+        vec![vec![a, a, c, a], vec![b, b, c, b]], // same runs: in place
+        vec![vec![a, a, c, a], vec![b, Pixel::BACKGROUND, c, b]],
+    ] {
+        let sparse: Vec<SparseImage<Pixel>> =
+            images.iter().map(|i| SparseImage::encode(0, i)).collect();
+        let combined = sparse[0].combine(&sparse[1], Pixel::over).unwrap();
+        assert!(SparseImage::<Pixel>::from_bytes(&combined.to_bytes()).is_ok());
+        let mode = Mode::Over { order: vec![0, 1] };
+        let expected = bits(&fold(&images, &mode));
+        for (r, o) in run(&images, (2, 2), Schedule::DirectSend, &mode).into_iter().enumerate() {
+            let (img, _) = o.unwrap_or_else(|e| panic!("rank {r}: {e}"));
+            if let Some(img) = img {
+                assert_eq!(bits(&img), expected);
+                assert!(img[0].is_background());
+            }
+        }
+    }
+}
+
 #[test]
 fn background_is_never_sent() {
     // Eight ranks of 64×64 with nothing drawn: messages carry headers only.

@@ -1,8 +1,17 @@
-//! A `no_std`, no-allocator user of rt-core and rt-accel: loads a BVH from
-//! bytes and traces a ray through it.
+//! A `no_std` user of the rt crates: loads a BVH from bytes and traces a
+//! ray through it (no allocator needed), bends a ray through a linear
+//! index, and z-composites two encoded sparse images (on `alloc`, served
+//! by a bump allocator over a static arena).
 #![no_std]
 
-use core::panic::PanicInfo;
+extern crate alloc;
+
+use core::{
+    alloc::{GlobalAlloc, Layout},
+    cell::UnsafeCell,
+    panic::PanicInfo,
+    sync::atomic::{AtomicUsize, Ordering},
+};
 
 use rt_accel::{BvhRef, TriPacket};
 use rt_core::{Ray, glam::Vec3};
@@ -10,6 +19,61 @@ use rt_core::{Ray, glam::Vec3};
 #[panic_handler]
 fn panic(_: &PanicInfo<'_>) -> ! {
     loop {}
+}
+
+/// A bump allocator over 1 MiB that never frees: enough to show that
+/// rt-composite needs only `alloc`.
+struct Bump {
+    arena: UnsafeCell<[u8; 1 << 20]>,
+    next: AtomicUsize,
+}
+
+// SAFETY: the arena is handed out in disjoint pieces by an atomic cursor.
+unsafe impl Sync for Bump {}
+
+// SAFETY: every block is inside the arena, aligned, and never handed out
+// twice.
+unsafe impl GlobalAlloc for Bump {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let base = self.arena.get().cast::<u8>();
+        let mut at = self.next.load(Ordering::Relaxed);
+        loop {
+            let start = (base as usize + at).next_multiple_of(layout.align()) - base as usize;
+            let end = start + layout.size();
+            if end > 1 << 20 {
+                return core::ptr::null_mut();
+            }
+            match self.next.compare_exchange(at, end, Ordering::Relaxed, Ordering::Relaxed) {
+                // SAFETY: `start..end` lies in the arena.
+                Ok(_) => return unsafe { base.add(start) },
+                Err(now) => at = now,
+            }
+        }
+    }
+
+    unsafe fn dealloc(&self, _: *mut u8, _: Layout) {}
+}
+
+#[global_allocator]
+static HEAP: Bump = Bump { arena: UnsafeCell::new([0; 1 << 20]), next: AtomicUsize::new(0) };
+
+/// Depth of the nearer of two one-pixel images after encoding, sending
+/// (bytes) and z-compositing them; NaN on a decoding error.
+#[must_use]
+pub fn nearer(a: f32, b: f32) -> f32 {
+    use rt_composite::{Fragment, SparseImage};
+    use rt_core::Pixel;
+    let enc = |d: f32| SparseImage::encode(0, &[Pixel { color: [1.0; 4], depth: d }]).to_bytes();
+    let (Ok(x), Ok(y)) =
+        (SparseImage::<Pixel>::from_bytes(&enc(a)), SparseImage::<Pixel>::from_bytes(&enc(b)))
+    else {
+        return f32::NAN;
+    };
+    let mut out = [Pixel::BACKGROUND];
+    if let Some(z) = x.combine(&y, Pixel::z) {
+        z.write_into(&mut out);
+    }
+    out[0].depth
 }
 
 /// Distance to the closest triangle of the serialized BVH `bytes` along the
