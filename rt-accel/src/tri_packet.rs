@@ -114,8 +114,12 @@ impl TriPacket {
         let det = u.add(v).add(w);
         let tt = u.mul(sz.mul(az)).add(v.mul(sz.mul(bz))).add(w.mul(sz.mul(cz)));
         let t = tt.mul(F32x4::splat(1.0).div(det));
-        let in_range = ctx.t_min.le_mask(t) & t.le_mask(t_max);
-        let ok = !(neg & pos) & !det.eq_mask(zero) & in_range & !on_edge & 0xf;
+        let inf = F32x4::splat(f32::INFINITY);
+        // `t < ∞` as the scalar test: an overflowed `t` is no hit.
+        let in_range = ctx.t_min.le_mask(t) & t.le_mask(t_max) & t.lt_mask(inf);
+        // As the scalar test: an overflowed `det` is no hit.
+        let finite = det.lt_mask(inf) & F32x4::splat(f32::NEG_INFINITY).lt_mask(det);
+        let ok = !(neg & pos) & !det.eq_mask(zero) & finite & in_range & !on_edge & 0xf;
         (ok, on_edge & 0xf, t.to_array())
     }
 }

@@ -613,3 +613,30 @@ fn rays_within_rounding_of_a_face_match_brute_force() {
     let r = Ray::new(Vec3::new(0.5, 1.0000001, 1.0), Vec3::new(1.0e-7, -1.0e-7, -0.0));
     check_triangles(&bvh, &pos, &idx, &r);
 }
+
+/// Found by the `bvh` fuzz target: vertices near `f32::MAX` make the
+/// packet test's `t` overflow to `+∞`, which `occluded` took for a hit
+/// while `closest_hit` (and brute force) found none. A `t` of `+∞` is no
+/// hit anywhere now.
+#[test]
+fn fuzz_regression_overflowing_t_is_no_hit() {
+    let tiny = f32::MIN_POSITIVE;
+    let pos = vec![
+        Vec3::new(0.0, tiny, tiny),
+        Vec3::new(tiny, tiny, 0.0),
+        Vec3::new(-3.9375, 0.0, f32::MAX),
+        Vec3::new(-1.125, -1.125, -1.125),
+        Vec3::new(-1.125, -1.125, 1.375),
+        Vec3::new(3.875, tiny, tiny),
+    ];
+    let idx = vec![[0, 1, 2], [2, 4, 5]];
+    let ray = Ray::new(Vec3::new(1.4375, tiny, 1.3125), Vec3::new(1.3125, 1.3125, -3.6875));
+    for params in [
+        rt_accel::BuildParams::fast(),
+        rt_accel::BuildParams::medium(),
+        rt_accel::BuildParams::slow(),
+    ] {
+        let bvh = build_triangles(&pos, &idx, &params).unwrap();
+        assert_eq!(check_triangles(&bvh, &pos, &idx, &ray), None);
+    }
+}

@@ -176,7 +176,8 @@ impl Cutoff {
         }
     }
 
-    /// Transmission per channel for deflection `(eu, ev)`.
+    /// Transmission per channel for deflection `(eu, ev)`, in `[0, 1]`; a
+    /// NaN deflection is blocked (0) by every cutoff but [`Cutoff::None`].
     #[must_use]
     pub fn transmit(&self, eu: f64, ev: f64) -> [f32; 3] {
         self.prepare().transmit(eu, ev)
@@ -204,8 +205,9 @@ impl Prepared<'_> {
     /// As [`Cutoff::transmit`].
     pub(crate) fn transmit(&self, eu: f64, ev: f64) -> [f32; 3] {
         let along = eu * self.cos + ev * self.sin;
+        // A NaN deflection (or `0·∞` from one) is blocked, never a NaN.
         let gray = |t: f64| {
-            let t = t.clamp(0.0, 1.0) as f32;
+            let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) as f32 };
             [t; 3]
         };
         match self.cutoff {
@@ -224,6 +226,18 @@ impl Prepared<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Found by the `cutoff` fuzz target: a NaN deflection came out of the
+    /// knife edge as a NaN transmission.
+    #[test]
+    fn fuzz_regression_nan_deflection_is_blocked() {
+        let k = Cutoff::KnifeEdge { angle: -0.6875, offset: 0.375, f: 0.3125, h: 0.375 };
+        assert_eq!(k.transmit(f64::NAN, 0.375), [0.0; 3]);
+        let g = Cutoff::Graded { angle: 0.0, f: 1.0, width: 1.0 };
+        assert_eq!(g.transmit(f64::INFINITY, f64::NAN), [0.0; 3]);
+        let p = Cutoff::Pinhole { f: 1.0, radius: 1.0, dark_field: false };
+        assert_eq!(p.transmit(f64::NAN, 0.0), [0.0; 3]);
+    }
 
     #[test]
     fn knife_edge_is_the_documented_ramp() {

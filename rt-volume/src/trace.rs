@@ -302,7 +302,9 @@ pub(crate) fn trace_impl<F: IndexField>(
         return Err(TraceError::InvalidRay);
     }
     check_params(params)?;
-    let d = direction.normalize();
+    // Scaled first: `|d|²` of a tiny (or huge) direction underflows to 0
+    // (overflows to ∞), and a plain `normalize` would give NaN.
+    let d = (direction / direction.abs().max_element()).normalize();
     let bounds = field.bounds();
     let ambient = field.ambient();
     let mut ev = Eval { field, bounds, ambient, evals: 0, last: None };
@@ -576,4 +578,44 @@ fn land_on_boundary<F: IndexField>(
     landed.x[axis] = plane;
     stats.steps += 1;
     Ok(landed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Bounds, LinearIndex};
+
+    /// Found by the `integrators` fuzz target: a direction of length
+    /// 3e-241 squared to 0 in `normalize`, and the trace returned NaN with
+    /// `Exit::Left`. Tiny and huge directions now trace as their unit
+    /// vector does.
+    #[test]
+    fn fuzz_regression_tiny_and_huge_directions() {
+        let f = LinearIndex {
+            n0: 1.0,
+            gradient: DVec3::new(0.0, 0.1, 0.0),
+            bounds: Bounds::new(DVec3::splat(-1.0), DVec3::splat(1.0)),
+        };
+        let p = TraceParams::accurate();
+        let unit = trace(&f, DVec3::new(-2.0, 0.0, 0.0), DVec3::X, &p).unwrap();
+        for s in [-2.999393638964874e-241, 1e-300, 1e300, f64::MAX] {
+            let r = trace(&f, DVec3::new(-2.0, 0.0, 0.0), DVec3::X * s.abs(), &p).unwrap();
+            assert_eq!(r, unit, "direction scaled by {s:e}");
+        }
+        // The fuzzer's own case: a ray beside the box along a tiny -z.
+        let f = LinearIndex {
+            n0: 1.5,
+            gradient: DVec3::splat(-1.625),
+            bounds: Bounds::new(DVec3::new(-2.3125, -1.625, -4.0), DVec3::ZERO),
+        };
+        let r = trace(
+            &f,
+            DVec3::new(-3.5, 0.0, 0.0),
+            DVec3::new(0.0, 0.0, -2.999393638964874e-241),
+            &p,
+        )
+        .unwrap();
+        assert_eq!(r.exit, Exit::Missed);
+        assert!(r.position.is_finite() && r.direction.is_finite());
+    }
 }

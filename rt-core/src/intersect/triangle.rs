@@ -95,14 +95,18 @@ pub fn intersect_triangle_t(
         return None;
     }
     let det = u + v + w;
-    if det == 0.0 || det.is_nan() {
+    // An overflowed `det` (vertices near `f32::MAX`) would make `t` a
+    // meaningless ±0: no hit, as in the packet test.
+    if det == 0.0 || !det.is_finite() {
         return None;
     }
     // Scaled hit distance, then the true one.
     let tt = u * (s.z * a[kz]) + v * (s.z * b[kz]) + w * (s.z * c[kz]);
     let inv = 1.0 / det;
     let t = tt * inv;
-    if !(t >= ray.t_min && t <= ray.t_max) {
+    // A `t` that overflowed to `+∞` (vertices near `f32::MAX`) is no hit,
+    // even for a ray with `t_max = ∞`.
+    if !(t >= ray.t_min && t <= ray.t_max && t < f32::INFINITY) {
         return None;
     }
     // `t` interpolates the vertices' distances with the barycentrics: for
