@@ -279,11 +279,23 @@ pub(crate) struct Skip {
 /// Step, tolerance and limits finite and positive.
 pub(crate) fn check_params(params: &TraceParams) -> Result<(), TraceError> {
     let ok = |v: f64| v.is_finite() && v > 0.0;
-    if !(ok(params.step) && ok(params.tolerance) && ok(params.max_length)) || params.max_steps == 0
+    // `max_step` may be `+∞` (no cap) but must be positive: it caps every
+    // method's step, and a negative one would trace the ray backwards.
+    let cap = params.max_step > 0.0;
+    if !(ok(params.step) && ok(params.tolerance) && ok(params.max_length) && cap)
+        || params.max_steps == 0
     {
         return Err(TraceError::InvalidParams);
     }
     Ok(())
+}
+
+/// `v / |v|` for any finite non-zero `v`: where `|v|²` underflows or
+/// overflows (a tiny or huge vector) it is scaled first, since a plain
+/// `normalize` would give NaN. (`T = n·d̂` is tiny where `n` is.)
+fn unit(v: DVec3) -> DVec3 {
+    let l2 = v.length_squared();
+    if l2.is_normal() { v.normalize() } else { (v / v.abs().max_element()).normalize() }
 }
 
 /// [`trace`] with a skip oracle: before each step, `skip(x, T)` may return
@@ -302,9 +314,7 @@ pub(crate) fn trace_impl<F: IndexField>(
         return Err(TraceError::InvalidRay);
     }
     check_params(params)?;
-    // Scaled first: `|d|²` of a tiny (or huge) direction underflows to 0
-    // (overflows to ∞), and a plain `normalize` would give NaN.
-    let d = (direction / direction.abs().max_element()).normalize();
+    let d = unit(direction);
     let bounds = field.bounds();
     let ambient = field.ambient();
     let mut ev = Eval { field, bounds, ambient, evals: 0, last: None };
@@ -341,7 +351,7 @@ pub(crate) fn trace_impl<F: IndexField>(
             None => skip(y.x, y.t),
         };
         if let Some(Skip { len, bound, n: known }) = offer {
-            let d = y.t.normalize();
+            let d = unit(y.t);
             // A skip that would leave the bounds stops on their surface.
             let inside = bounds.contains(y.x + len * d);
             let len = if inside { len } else { bounds.clip(y.x, d).map_or(0.0, |(_, t1)| t1) };
@@ -393,7 +403,7 @@ pub(crate) fn trace_impl<F: IndexField>(
     };
     stats.field_evals = ev.evals;
     stats.invariant_drift = stats.invariant_drift.max((y.t.length() - n).abs());
-    Ok(TraceResult { position: y.x, direction: y.t.normalize(), optical_path: y.opl, exit, stats })
+    Ok(TraceResult { position: y.x, direction: unit(y.t), optical_path: y.opl, exit, stats })
 }
 
 /// One step of size `h` (for `Adaptive`: one uncontrolled Dormand–Prince
@@ -576,6 +586,10 @@ fn land_on_boundary<F: IndexField>(
     // Snap the exit coordinate onto the face it is on (within `tol`).
     let (_, axis, plane) = outside_by(&landed);
     landed.x[axis] = plane;
+    // Where the search could not resolve the crossing (a field so extreme
+    // that one step is far from straight: found by fuzzing with n ≈ 1e38),
+    // the other coordinates may still lie outside: the exit is on the box.
+    landed.x = landed.x.clamp(b.min, b.max);
     stats.steps += 1;
     Ok(landed)
 }
@@ -602,6 +616,29 @@ mod tests {
             let r = trace(&f, DVec3::new(-2.0, 0.0, 0.0), DVec3::X * s.abs(), &p).unwrap();
             assert_eq!(r, unit, "direction scaled by {s:e}");
         }
+        // A negative step cap (also from the fuzzer) traced backwards out
+        // of the box; it is an error now, as is NaN.
+        for max_step in [-0.1875, 0.0, f64::NAN] {
+            let q = TraceParams { max_step, ..TraceParams::fixed(Method::Symplectic, 3.875) };
+            assert_eq!(trace(&f, DVec3::ZERO, DVec3::X, &q), Err(TraceError::InvalidParams));
+        }
+        // n ≈ 3.4e38 with a gradient: one Euler step leaves far from
+        // straight and the exit search cannot resolve it; the exit point
+        // must still be on the box (it was 1e21 away).
+        let huge = LinearIndex {
+            n0: 3.4028234663852886e38,
+            gradient: DVec3::new(0.0, -1.625, -1.625),
+            bounds: Bounds::new(DVec3::new(-2.3125, -1.5, -4.0), DVec3::ZERO),
+        };
+        let r = trace(
+            &huge,
+            DVec3::new(-1.125, -1.625, -1.625),
+            DVec3::new(-3.9375, 3.4028234663852886e38, 3.4028234663852886e38),
+            &TraceParams::fixed(Method::Euler, 0.01),
+        )
+        .unwrap();
+        assert_eq!(r.exit, Exit::Left);
+        assert!(huge.bounds.contains(r.position), "{r:?}");
         // The fuzzer's own case: a ray beside the box along a tiny -z.
         let f = LinearIndex {
             n0: 1.5,
