@@ -162,7 +162,8 @@ pub enum TraceError {
     InvalidRay,
     /// Step, tolerance or limits not finite and positive.
     InvalidParams,
-    /// The field returned a NaN/∞ index or gradient (or `n ≤ 0`) at a point.
+    /// The field returned a NaN/∞ index or gradient (or `n ≤ 0`) at a point,
+    /// or its values are so large that the path overflowed there.
     BadField {
         /// Where.
         at: DVec3,
@@ -403,6 +404,11 @@ pub(crate) fn trace_impl<F: IndexField>(
     };
     stats.field_evals = ev.evals;
     stats.invariant_drift = stats.invariant_drift.max((y.t.length() - n).abs());
+    if !(y.x.is_finite() && y.t.is_finite() && y.opl.is_finite()) {
+        // n near f64's range (found by fuzzing with n ≈ 1e38): the optical
+        // path or momentum overflowed.
+        return Err(TraceError::BadField { at: y.x });
+    }
     Ok(TraceResult { position: y.x, direction: unit(y.t), optical_path: y.opl, exit, stats })
 }
 
@@ -639,6 +645,27 @@ mod tests {
         .unwrap();
         assert_eq!(r.exit, Exit::Left);
         assert!(huge.bounds.contains(r.position), "{r:?}");
+        // An ambient index of 4e281: the optical path through it overflows;
+        // an error, not an infinite result.
+        let grid = crate::Grid::new(
+            [2, 2, 2],
+            DVec3::splat(3.875),
+            DVec3::splat(3.875),
+            alloc::vec![0.999, 0.999, 0.999, 0.999, 0.999, 1.0, 1.008, 1.0],
+        )
+        .unwrap();
+        let field =
+            crate::GridField::new(grid, crate::Interp::CatmullRom, 4.1477712300041504e281).unwrap();
+        let q = TraceParams {
+            tolerance: 1.1920928955078125e-7,
+            max_step: 3.875,
+            max_steps: 5020,
+            max_length: 3.875,
+            ..TraceParams::fixed(Method::Symplectic, 1.1920928955078125e-7)
+        };
+        let r =
+            trace(&field, DVec3::new(-2.125, 3.4375, 3.4375), DVec3::new(3.4375, -1.125, 3.5), &q);
+        assert!(matches!(r, Err(TraceError::BadField { .. })), "{r:?}");
         // The fuzzer's own case: a ray beside the box along a tiny -z.
         let f = LinearIndex {
             n0: 1.5,
