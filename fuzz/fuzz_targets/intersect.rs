@@ -31,7 +31,7 @@ fuzz_target!(|data: &[u8]| {
     }
     let capsule = Capsule { p0: a, radius, p1: b, pad: 0.0 };
     if let Some(h) = intersect_capsule(&r, &capsule, 0) {
-        check_t(&r, h.t, "capsule");
+        check_t(&r, h.t, &format!("capsule {capsule:?}"));
         assert!(capsule.is_valid() && r.is_valid(), "{capsule:?} {r:?}");
     }
     let boxed = Aabb::new(a.min(b), a.max(b));

@@ -75,8 +75,10 @@ pub fn intersect_capsule_t(ray: &Ray, cap: &Capsule) -> Option<f32> {
     let mut best: Option<f32> = None;
     let bounds = cap.bounds();
     let mut keep = |t: f32| {
+        // `t < ∞`: roots overflow for radii near `f32::MAX`; no hit there.
         if t >= ray.t_min
             && t <= ray.t_max
+            && t < f32::INFINITY
             && best.is_none_or(|b| t < b)
             && bounds.admits_hit(ray, t)
         {
@@ -146,6 +148,22 @@ pub fn intersect_capsule(ray: &Ray, cap: &Capsule, prim: u32) -> Option<Hit> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Found by the `intersect` fuzz target: a radius of `f32::MAX` made a
+    /// root overflow, and the capsule reported a hit at `t = ∞`.
+    #[test]
+    fn fuzz_regression_no_hit_at_infinity() {
+        let cap = Capsule {
+            p0: Vec3::new(0.0, -1.0, 3.875),
+            radius: f32::MAX,
+            p1: Vec3::new(3.875, -3.75, 0.0),
+            pad: 0.0,
+        };
+        let ray = Ray::new(Vec3::new(1.9375, 1.9375, 1.3125), Vec3::new(1.9375, -2.875, -3.75));
+        assert!(intersect_capsule_t(&ray, &cap).is_none_or(|t| t.is_finite()));
+        let s = crate::intersect::Sphere { center: cap.p0, radius: f32::MAX };
+        assert!(crate::intersect::intersect_sphere_t(&ray, &s).is_none_or(|t| t.is_finite()));
+    }
 
     fn cap() -> Capsule {
         Capsule::new(Vec3::ZERO, Vec3::new(0.0, 0.0, 2.0), 0.5)

@@ -96,7 +96,10 @@ pub(crate) fn first_in_range(
     t1: f32,
     admits: impl Fn(f32) -> bool,
 ) -> Option<f32> {
-    [t0, t1].into_iter().find(|&t| t >= ray.t_min && t <= ray.t_max && admits(t))
+    // `t < ∞`: roots overflow for radii near `f32::MAX`; no hit there.
+    [t0, t1]
+        .into_iter()
+        .find(|&t| t >= ray.t_min && t <= ray.t_max && t < f32::INFINITY && admits(t))
 }
 
 /// Full hit record for a sphere: the hit point is re-projected onto the
