@@ -10,7 +10,10 @@ use std::{fmt::Write as _, hint::black_box, path::Path, time::Duration};
 use rt_composite::{Fragment, Mode, Schedule, ThreadComm, composite, serial_fold};
 use rt_core::Pixel;
 
-use crate::timing::{Samples, time};
+use crate::{
+    Section,
+    timing::{Samples, time},
+};
 
 /// A rank's image: the data cover `active` of the screen (blocks of 64
 /// pixels chosen by a hash shared by all ranks: renders are coherent and
@@ -45,7 +48,7 @@ fn bits_equal(a: &[Pixel], b: &[Pixel]) -> bool {
         })
 }
 
-pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
+pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let mut csv = String::from(
         "algorithm,ranks,width,height,active_fraction,seconds,bytes_sent,identical_to_serial\n",
     );
@@ -173,10 +176,13 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
         "sparse bytes sent ≤ {worst_ratio:.2} × active fraction × dense bytes (target ≤ 1.2)"
     ));
     std::fs::write(dir.join("composite.csv"), &csv).map_err(|e| e.to_string())?;
-    println!(
-        "## composite (in-process ranks on threads; seconds are wall time on this machine's cores)\n\n{md}\n- {}\nwrote {}",
-        verdicts.join("\n- "),
-        dir.join("composite.csv").display()
-    );
-    Ok(())
+    writeln!(md, "\nwrote {}", dir.join("composite.csv").display()).unwrap();
+    Ok(Section {
+        title:
+            "composite (in-process ranks on threads; seconds are wall time on this machine's cores)"
+                .into(),
+        body: md,
+        verdicts,
+        plots: vec![],
+    })
 }

@@ -12,7 +12,7 @@ use rt_volume::{
     Bounds, GaussianBump, GrinRod, IndexField, LinearIndex, Luneburg, Method, TraceParams, trace,
 };
 
-use crate::timing::time;
+use crate::{Section, timing::time};
 
 /// A ray launched into a case, with the exact exit point.
 struct Probe {
@@ -142,12 +142,13 @@ fn params(method: Method, quick: bool) -> Vec<TraceParams> {
     }
 }
 
-pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
+pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let mut csv = String::from(
         "case,integrator,tolerance,steps,field_evals,seconds,endpoint_error,invariant_drift\n",
     );
     let mut md = String::new();
     let mut verdicts = Vec::new();
+    let mut plots = Vec::new();
     let (lf, lp) = linear();
     let (gf, gp) = grin_rod();
     let (uf, up) = luneburg();
@@ -185,6 +186,10 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
         }
         let png = dir.join(format!("grin-{case}.png"));
         loglog(&series, 640, 480, &png)?;
+        plots.push((
+            format!("grin-{case}.png"),
+            format!("{case}: endpoint error (y) against seconds per ray (x); euler red, rk4 blue, adaptive green, symplectic purple; rings: Pareto front"),
+        ));
         // Headline: cheapest run of each method reaching 1e-4, and the best error.
         writeln!(md, "\n### {case}\n\n| integrator | evals/ray for error ≤ 1e-4 | best error | drift there |\n|---|---|---|---|").unwrap();
         let mut need = Vec::new();
@@ -223,10 +228,11 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
         writeln!(md, "\nPlot `{}`: error (y) against seconds per ray (x), log–log; euler red, rk4 blue, adaptive green, symplectic purple; ringed points form the Pareto front.", png.display()).unwrap();
     }
     std::fs::write(dir.join("grin.csv"), &csv).map_err(|e| e.to_string())?;
-    println!("## grin (curved rays: endpoint error against run time)\n{md}");
-    for v in &verdicts {
-        println!("- {v}");
-    }
-    println!("\nwrote {}", dir.join("grin.csv").display());
-    Ok(())
+    writeln!(md, "\nwrote {}", dir.join("grin.csv").display()).unwrap();
+    Ok(Section {
+        title: "grin (curved rays: endpoint error against run time)".into(),
+        body: md,
+        verdicts,
+        plots,
+    })
 }

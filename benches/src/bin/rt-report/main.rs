@@ -8,7 +8,7 @@
 //! cargo run --release -p rt-benches --bin rt-report -- schlieren [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- render [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- composite [--quick]
-//! cargo run --release -p rt-benches --bin rt-report -- all [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- all [--quick]   # + index.md
 //! ```
 // A std-only tool crate: the no_std import lints guard the libraries.
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
@@ -36,12 +36,72 @@ fn out_dir() -> PathBuf {
     target.join("rt-report")
 }
 
+/// One area's part of the report.
+pub(crate) struct Section {
+    /// Heading (without `##`).
+    pub(crate) title: String,
+    /// Tables and notes, markdown.
+    pub(crate) body: String,
+    /// One line each, against the area's targets.
+    pub(crate) verdicts: Vec<String>,
+    /// `(file name in the report folder, caption)`.
+    pub(crate) plots: Vec<(String, String)>,
+}
+
+/// CPU model and core count, from `/proc/cpuinfo` and the OS.
+fn machine() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    format!("{model}, {cores} cores available, {} {}", std::env::consts::OS, std::env::consts::ARCH)
+}
+
+/// `index.md`: the machine, then per area its verdicts, plots and tables.
+fn index(sections: &[(&str, Section)], quick: bool, seconds: f64) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::from("# rt report: run time against error\n\n");
+    writeln!(
+        out,
+        "Machine: {}. Mode: {}. Took {seconds:.0} s. Command: `cargo run --release -p rt-benches --bin rt-report -- all{}`.\n",
+        machine(),
+        if quick { "quick (smaller problems, fewer repetitions)" } else { "full" },
+        if quick { " --quick" } else { "" }
+    )
+    .unwrap();
+    out.push_str("How to read it: each area has one line per target (met / NOT met), its plot — error (y) against run time (x) on log–log axes, the Pareto front ringed (no other point is both faster and more accurate) — and its table. Timings are best of N runs with the spread (slowest over fastest); ratios between implementations come from the same run. CSV files beside this page hold every number.\n\n## Verdicts\n\n");
+    for (area, s) in sections {
+        for v in &s.verdicts {
+            writeln!(out, "- **{area}**: {v}").unwrap();
+        }
+    }
+    for (_, s) in sections {
+        writeln!(out, "\n## {}\n", s.title).unwrap();
+        for v in &s.verdicts {
+            writeln!(out, "- {v}").unwrap();
+        }
+        for (file, caption) in &s.plots {
+            writeln!(out, "\n![{caption}]({file})\n\n*{file}*: {caption}.").unwrap();
+        }
+        writeln!(out, "\n{}", s.body).unwrap();
+    }
+    out
+}
+
 fn main() -> ExitCode {
+    let t0 = std::time::Instant::now();
     let args: Vec<String> = std::env::args().skip(1).collect();
     let quick = args.iter().any(|a| a == "--quick");
     let areas: Vec<&str> =
         args.iter().filter(|a| !a.starts_with("--")).map(String::as_str).collect();
-    let areas = if areas.is_empty() || areas == ["all"] {
+    let all = areas.is_empty() || areas == ["all"];
+    let areas = if all {
         vec!["traversal", "grin", "octree", "schlieren", "render", "composite"]
     } else {
         areas
@@ -51,6 +111,7 @@ fn main() -> ExitCode {
         eprintln!("cannot create {}: {e}", dir.display());
         return ExitCode::FAILURE;
     }
+    let mut sections = Vec::new();
     for area in areas {
         let result = match area {
             "traversal" => traversal::run(&dir, quick),
@@ -63,10 +124,31 @@ fn main() -> ExitCode {
                 "unknown area `{other}` (known: traversal, grin, octree, schlieren, render, composite, all)"
             )),
         };
-        if let Err(e) = result {
-            eprintln!("rt-report {area}: {e}");
+        match result {
+            Ok(s) => {
+                println!("## {}\n\n{}", s.title, s.body);
+                for v in &s.verdicts {
+                    println!("- {v}");
+                }
+                for (file, caption) in &s.plots {
+                    println!("- plot {}: {caption}", dir.join(file).display());
+                }
+                println!();
+                sections.push((area, s));
+            }
+            Err(e) => {
+                eprintln!("rt-report {area}: {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+    if all {
+        let path = dir.join("index.md");
+        if let Err(e) = std::fs::write(&path, index(&sections, quick, t0.elapsed().as_secs_f64())) {
+            eprintln!("cannot write {}: {e}", path.display());
             return ExitCode::FAILURE;
         }
+        println!("wrote {}", path.display());
     }
     ExitCode::SUCCESS
 }

@@ -17,7 +17,10 @@ use rt_core::{
     Camera, ColorMap, Frame, Light, Material, Projection, Ray, Renderer, SceneQuery, Settings,
 };
 
-use crate::timing::{Samples, time};
+use crate::{
+    Section,
+    timing::{Samples, time},
+};
 
 /// Single-thread closest-hit rays per second of `scene` on `rays`, best of 3.
 fn traversal_rate(scene: &SurfaceScene<'_>, rays: &[Ray]) -> f64 {
@@ -55,7 +58,7 @@ fn rmse(a: &Frame, b: &Frame) -> f64 {
     (s / (3 * a.pixels().len()) as f64).sqrt()
 }
 
-pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
+pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     // 725² vertices: 1 048 352 triangles (the quick run: 257², 131 072).
     let (n, size) = if quick { (257, 512) } else { (725, 1024) };
     let t = scenes::terrain(n);
@@ -162,20 +165,30 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
         }
     }
     std::fs::write(dir.join("render.csv"), &csv).map_err(|e| e.to_string())?;
-    println!(
-        "## render ({} triangles, {size}², one pass, directional light with shadows + ambient)\n\n{md}\n- {}\nwrote {}",
-        scene.triangle_count(),
-        verdicts.join("\n- "),
-        dir.join("render.csv").display()
-    );
-    ao_error(dir, &scene, quick)
+    writeln!(md, "\nwrote {}", dir.join("render.csv").display()).unwrap();
+    md.push_str(&ao_error(dir, &scene, quick)?);
+    Ok(Section {
+        title: format!(
+            "render ({} triangles, {size}², one pass, directional light with shadows + ambient)",
+            scene.triangle_count()
+        ),
+        body: md,
+        verdicts,
+        plots: vec![(
+            "render.png".into(),
+            format!(
+                "AO rmse against a 256-ray reference (y) against seconds (x) for 1–16 AO rays ({}); rings: Pareto front",
+                PALETTE[0].1
+            ),
+        )],
+    })
 }
 
 /// Run time against error of ambient occlusion: frames with 1–16 AO rays
 /// per pixel (one pass, pixel centres, all cores) against a 256-ray
 /// reference of the same pixels, so the only error is AO's Monte-Carlo
 /// noise (the reference's own noise adds at most 3 % to the 16-ray rmse).
-fn ao_error(dir: &Path, scene: &SurfaceScene<'_>, quick: bool) -> Result<(), String> {
+fn ao_error(dir: &Path, scene: &SurfaceScene<'_>, quick: bool) -> Result<String, String> {
     let size = if quick { 128 } else { 256 };
     let cam = Camera::look_at(
         Vec3::new(0.9, 0.5, 0.9),
@@ -212,13 +225,12 @@ fn ao_error(dir: &Path, scene: &SurfaceScene<'_>, quick: bool) -> Result<(), Str
     std::fs::write(dir.join("render-ao.csv"), &csv).map_err(|e| e.to_string())?;
     let png = dir.join("render.png");
     loglog(&[Series { points, color: PALETTE[0].0 }], 640, 480, &png)?;
-    println!(
-        "\n### AO error against run time ({size}², one pass, all cores; reference: 256 AO rays)\n\n{md}\n\
+    Ok(format!(
+        "\n### AO error against run time ({size}², one pass, all cores, best of 3; reference: 256 AO rays)\n\n{md}\n\
          - Monte-Carlo AO: rmse × √N should stay flat (error ∝ N^-1/2).\n\
-         wrote {} and {} (x: seconds, y: rmse, {})",
+         wrote {} and {} (x: seconds, y: rmse, {})\n",
         dir.join("render-ao.csv").display(),
         png.display(),
         PALETTE[0].1
-    );
-    Ok(())
+    ))
 }

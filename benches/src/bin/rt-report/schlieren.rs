@@ -13,7 +13,10 @@ use rt_benches::{
 use rt_photo::{Film, Filter};
 use rt_volume::{Method, TraceParams, build_octree, trace, trace_skipping};
 
-use crate::timing::time;
+use crate::{
+    Section,
+    timing::{Samples, time},
+};
 
 const FILM: usize = 128;
 
@@ -23,7 +26,7 @@ fn rmse(a: &Film, b: &Film) -> f64 {
     (s / x.len() as f64).sqrt()
 }
 
-pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
+pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let f = sparse_bumps();
     let tree = build_octree(&f).map_err(|e| e.to_string())?;
     let h = f.grid().spacing().x;
@@ -40,7 +43,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
     .map_err(|e| e.to_string())?;
     let strata: &[u32] = if quick { &[1, 2] } else { &[1, 2, 4, 8] };
     let mut csv = String::from("case,method,photons,seconds,rmse\n");
-    let mut rows: Vec<(String, u64, f64, f64)> = Vec::new();
+    let mut rows: Vec<(String, u64, f64, f64, f64)> = Vec::new();
     let rt = TraceParams::for_grid(&f);
     let runs = [
         ("original", TraceParams::fixed(Method::Euler, h)),
@@ -51,7 +54,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
         for (name, params) in runs {
             // Best of 3 (the film of the last run is kept; all are equal).
             let b = knife_bench(params, k);
-            let mut secs = f64::INFINITY;
+            let mut samples = Samples::default();
             let mut film = Film::new(FILM, FILM, Filter::Box).map_err(str::to_string)?;
             for _ in 0..3 {
                 film = Film::new(FILM, FILM, Filter::Box).map_err(str::to_string)?;
@@ -61,11 +64,12 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
                     time(|| b.render_grid(&f, &tree, &mut film, 0, 7))
                 };
                 r.map_err(|e| e.to_string())?;
-                secs = secs.min(t);
+                samples.0.push(t);
             }
+            let secs = samples.best();
             let e = rmse(&film, &reference);
             writeln!(csv, "sparse128,{name},{},{secs:.4},{e:e}", film.emitted).unwrap();
-            rows.push((name.to_string(), film.emitted, secs, e));
+            rows.push((name.to_string(), film.emitted, secs, e, samples.spread()));
         }
     }
     std::fs::write(dir.join("schlieren.csv"), &csv).map_err(|e| e.to_string())?;
@@ -79,11 +83,21 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
         .collect();
     let png = dir.join("schlieren.png");
     loglog(&series, 640, 480, &png)?;
-    let mut md =
-        String::from("| method | photons | seconds | photons/s | rmse |\n|---|---|---|---|---|\n");
+    let mut md = String::from(
+        "| method | photons | seconds (best of 3) | spread | photons/s | rmse |\n|---|---|---|---|---|---|\n",
+    );
     for r in &rows {
-        writeln!(md, "| {} | {} | {:.3} | {:.0} | {:.2e} |", r.0, r.1, r.2, r.1 as f64 / r.2, r.3)
-            .unwrap();
+        writeln!(
+            md,
+            "| {} | {} | {:.3} | +{:.0}% | {:.0} | {:.2e} |",
+            r.0,
+            r.1,
+            r.2,
+            r.4,
+            r.1 as f64 / r.2,
+            r.3
+        )
+        .unwrap();
     }
     // Speed at equal error: the time each rt configuration needs to reach
     // the original's rmse, interpolated log–log along its own sweep (its
@@ -120,11 +134,16 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<(), String> {
             if best >= 20.0 { "met" } else { "NOT met" }
         ));
     }
-    let best = verdicts.iter().map(String::as_str).collect::<Vec<_>>().join("\n- ");
-    println!(
-        "## schlieren (knife edge, sparse 128³ field, {FILM}² film, reference RK4 h/4 with 4M photons)\n\n{md}\n- {best}\n\nPlot `{}`: rmse (y) against seconds (x), log–log; original red, rt blue, rt-2voxel green.\nwrote {}",
-        png.display(),
-        dir.join("schlieren.csv").display()
-    );
-    Ok(())
+    writeln!(md, "\nwrote {}", dir.join("schlieren.csv").display()).unwrap();
+    Ok(Section {
+        title: format!(
+            "schlieren (knife edge, sparse 128³ field, {FILM}² film, reference RK4 h/4 with 4M photons)"
+        ),
+        body: md,
+        verdicts,
+        plots: vec![(
+            "schlieren.png".into(),
+            "rmse against the reference (y) against seconds (x); original red, rt blue, rt-2voxel green; rings: Pareto front".into(),
+        )],
+    })
 }

@@ -14,6 +14,11 @@ impl Samples {
     pub(crate) fn worst(&self) -> f64 {
         self.0.iter().copied().fold(0.0, f64::max)
     }
+
+    /// How much slower the slowest run was than the fastest, in percent.
+    pub(crate) fn spread(&self) -> f64 {
+        (self.worst() / self.best() - 1.0) * 100.0
+    }
 }
 
 /// Seconds taken by `f`, with its result.
