@@ -158,8 +158,9 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
                 }
             } else if let Some(s1) = single.get(&ao) {
                 verdicts.push(format!(
-                    "AO {ao}: parallel efficiency on {threads} cores {:.2} (target ≥ 0.9)",
-                    s1 / best / threads as f64
+                    "AO {ao}: parallel efficiency on {threads} cores {:.2} (target ≥ 0.9: {})",
+                    s1 / best / threads as f64,
+                    if s1 / best / threads as f64 >= 0.9 { "met" } else { "NOT met" }
                 ));
             }
         }

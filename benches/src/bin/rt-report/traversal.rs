@@ -234,9 +234,13 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         title: format!("traversal (single thread, closest hit, best of {REPS})"),
         body,
         verdicts: vec![format!(
-            "rt at ≥ {worst_ratio:.2}× obvhs-cwbvh's rate on every row, hit counts {} (target ≥ 1.0× with identical hits: {}); no error axis — every implementation answers exactly, the differences in hits are explained above",
-            if hits_equal { "identical" } else { "differing where explained" },
-            if worst_ratio >= 1.0 { "met" } else { "NOT met" }
+            "rt at ≥ {worst_ratio:.2}× obvhs-cwbvh's rate on every row (target ≥ 1.0×: {}); hit counts {}; no error axis — rt's answers equal brute force bit for bit (tested)",
+            if worst_ratio >= 1.0 { "met" } else { "NOT met" },
+            if hits_equal {
+                "identical"
+            } else {
+                "differ by the few rays listed under the table, where obvhs's Möller–Trumbore test leaks at shared edges (identical hits: NOT met, by design)"
+            }
         )],
         plots: vec![],
     })
