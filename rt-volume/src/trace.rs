@@ -655,7 +655,8 @@ mod tests {
         )
         .unwrap();
         let field =
-            crate::GridField::new(grid, crate::Interp::CatmullRom, 4.1477712300041504e281).unwrap();
+            crate::GridField::new(grid, crate::Interp::CatmullRom, 4.147_771_230_004_15e281)
+                .unwrap();
         let q = TraceParams {
             tolerance: 1.1920928955078125e-7,
             max_step: 3.875,
