@@ -640,3 +640,39 @@ fn fuzz_regression_overflowing_t_is_no_hit() {
         assert_eq!(check_triangles(&bvh, &pos, &idx, &ray), None);
     }
 }
+
+/// Found by the `bvh` fuzz target: with the slow presets' spatial
+/// pre-splits, a leaf held a clipped part of a triangle's box, and a hit
+/// on that box's boundary (at the ray origin, `t = -0.0`) fell outside it:
+/// the BVH missed what brute force hit. Boxes are refitted to the whole
+/// triangles now.
+#[test]
+fn fuzz_regression_pre_split_boxes_hold_whole_triangles() {
+    let t = f32::MIN_POSITIVE;
+    let pos = vec![
+        Vec3::new(-1.125, 0.0, -1.125),
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(1.192_092_9e-7, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(0.0, t, t),
+        Vec3::new(t, -4.0, 1e30),
+        Vec3::new(2.875, 2.25, 2.875),
+        Vec3::new(-0.75, t, t),
+        Vec3::new(t, 3.59e-43, 0.0),
+        Vec3::new(-448_843.8, t, t),
+        Vec3::new(t, t, -4.0),
+        Vec3::new(0.0, 0.0, 0.0),
+    ];
+    let idx = vec![[0, 1, 2], [3, 4, 5], [6, 7, 8], [8, 10, 11]];
+    let ray = Ray {
+        origin: Vec3::splat(t),
+        direction: Vec3::new(100_000.0, 0.0, 7.2027e-41),
+        t_min: 0.0,
+        t_max: f32::INFINITY,
+    };
+    for quality in rt_accel::BuildQuality::ALL {
+        let params = rt_accel::BuildParams { quality, ..rt_accel::BuildParams::medium() };
+        let bvh = build_triangles(&pos, &idx, &params).unwrap();
+        assert_eq!(check_triangles(&bvh, &pos, &idx, &ray), Some((-0.0, 1)), "{quality:?}");
+    }
+}
