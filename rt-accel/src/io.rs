@@ -233,7 +233,8 @@ pub fn read_mesh(path: &Path) -> Result<MeshData, ReadError> {
 /// one.
 ///
 /// # Errors
-/// [`ReadError::Malformed`] with `tobj`'s reason.
+/// [`ReadError::Malformed`] with `tobj`'s reason, or for an index that
+/// makes `tobj` itself fail.
 pub fn parse_obj(bytes: &[u8]) -> Result<MeshData, ReadError> {
     let options = tobj::LoadOptions {
         single_index: true,
@@ -241,9 +242,15 @@ pub fn parse_obj(bytes: &[u8]) -> Result<MeshData, ReadError> {
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _materials) =
-        tobj::load_obj_buf(&mut &bytes[..], &options, |_| Err(tobj::LoadError::OpenFileFailed))
-            .map_err(|e| ReadError::Malformed(format!("OBJ: {e}")))?;
+    // tobj 4.0.5 indexes texture coordinates and normals with unchecked
+    // arithmetic (`f 1/-2` far past the list overflows, found by the
+    // `read_obj` fuzz target): its panic is caught and reported as a
+    // malformed file. (Under `panic = "abort"` it would still abort.)
+    let load =
+        || tobj::load_obj_buf(&mut &bytes[..], &options, |_| Err(tobj::LoadError::OpenFileFailed));
+    let (models, _materials) = std::panic::catch_unwind(load)
+        .map_err(|_| ReadError::Malformed("OBJ: the parser failed on a bad index".into()))?
+        .map_err(|e| ReadError::Malformed(format!("OBJ: {e}")))?;
     let mut out = MeshData::default();
     for model in models {
         let m = model.mesh;

@@ -249,3 +249,25 @@ fn malformed_files_are_errors() {
     // An empty file is a valid, empty mesh.
     assert_eq!(parse_obj(b"").unwrap(), rt_accel::io::MeshData::default());
 }
+
+/// Found by the `read_obj` fuzz target: `tobj` overflows computing a
+/// texture-coordinate index (`f 1/-2` past the list) and panics; the
+/// reader answers `Err` instead.
+#[test]
+fn fuzz_regression_obj_bad_texcoord_index_is_an_error() {
+    let parts: [&[u8]; 10] = [
+        b"\nf\x0c 2 2  \n\nv\x0b\r5\r00\x0b0\n-\nv\x03\x0b\no\r\x19\n\x0b282  ?",
+        b"\nf\x0c 2 2 2  \n\nv\x0b\r5\r00\x0b0\n-\nv\x03\x0b\no\r\x19\n\x0b282  ",
+        b"?\nf\x0c 2 2 2  \n\nv\x0b\r5\r00\x0b0\n-\nv\x03\x0b\ng\r\x19\n\x0b    ",
+        b"  \nf\x0b 1 2 2/  1/-2 \n-\nv\x03\x0b\no$\r\x19\n\x0b282  ?\nf\x0c 2 2",
+        b" 2  \n35\n35\n\nvt\r50\x0b\x0b00\x0b\x0b0f\x0b0350\x0b3\nf\x0b3\nl35\n",
+        b"\n335\n\nvt\r50\x0b\x0b00\x0b\x0b0\nf35f\x0b//\nv\x0b\r0\x0b\x0b0\x0b8",
+        b"\nv\x03\x0b\ng\r\x19\n\x0b      \nf\x0b 1 2 2/  1/-2 \n-\nv\x03\x0b\no",
+        b"\r\x19\n\x0b282  ?\nf\x0c 2 2\x00\x00\x00\x00\x00\x00\x00\x8035\n\nvt",
+        b"\r50\x0b\x0b00\x0b\x0b0f\x0b0350\x0b3\nf\x0b3\nl35\n\n335\n\nvt\r50",
+        b"\x0b\x0b00\x0b\x0b0\nf35f\x0b//\nv\x0b\r0\x0b\x0b0\x0b828",
+    ];
+    let bytes = parts.concat();
+    assert_eq!(bytes.len(), 375);
+    assert!(matches!(parse_obj(&bytes), Err(ReadError::Malformed(_))));
+}
