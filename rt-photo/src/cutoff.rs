@@ -215,8 +215,10 @@ impl Prepared<'_> {
             Cutoff::KnifeEdge { offset, f, h, .. } => gray(0.5 + f / h * along + offset),
             Cutoff::Graded { f, width, .. } => gray(0.5 + f * along / width),
             Cutoff::Pinhole { f, radius, dark_field } => {
-                let inside = f * (eu * eu + ev * ev).sqrt() <= *radius;
-                gray(if inside != *dark_field { 1.0 } else { 0.0 })
+                let r = f * (eu * eu + ev * ev).sqrt();
+                let inside = r <= *radius;
+                // NaN is neither inside nor outside: blocked either way.
+                gray(if r.is_nan() || inside == *dark_field { 0.0 } else { 1.0 })
             }
             Cutoff::Color(img) => img.at(eu, ev),
         }
@@ -235,8 +237,10 @@ mod tests {
         assert_eq!(k.transmit(f64::NAN, 0.375), [0.0; 3]);
         let g = Cutoff::Graded { angle: 0.0, f: 1.0, width: 1.0 };
         assert_eq!(g.transmit(f64::INFINITY, f64::NAN), [0.0; 3]);
-        let p = Cutoff::Pinhole { f: 1.0, radius: 1.0, dark_field: false };
-        assert_eq!(p.transmit(f64::NAN, 0.0), [0.0; 3]);
+        for dark_field in [false, true] {
+            let p = Cutoff::Pinhole { f: 1.0, radius: 1.0, dark_field };
+            assert_eq!(p.transmit(f64::NAN, 0.0), [0.0; 3]);
+        }
     }
 
     #[test]
