@@ -137,3 +137,52 @@ fn bad_fields_rays_and_params_are_errors() {
         assert_eq!(trace(&f, DVec3::ZERO, DVec3::X, &bad), Err(TraceError::InvalidParams));
     }
 }
+
+/// ORACLES §1 at every scale: the catenary in `n = 1 + (0.2/s)·y` over a
+/// box scaled by `s = 10^k`, k in -8..=8, launched along +x (direction
+/// also scaled, by 1/s), with the step and path limit scaled with the box.
+/// The path has the same shape at every scale, so the exit height over `s`
+/// must match the oracle to 1e-7, the slope and the optical path over `s`
+/// too, and `| |T| − n |` stays at rounding: fixed-step RK4 at every
+/// scale, the adaptive scheme (absolute tolerance) from 1e-8 to 1e6.
+#[test]
+fn catenary_is_scale_free_from_1e_minus_8_to_1e8() {
+    let (g, x) = (0.2f64, 2.0f64);
+    let y = (g * x).cosh() / g - 1.0 / g;
+    let slope = (g * x).sinh();
+    let opl = x / 2.0 + (2.0 * g * x).sinh() / (4.0 * g);
+    for k in -8..=8 {
+        let s = 10f64.powi(k);
+        let f = LinearIndex {
+            n0: 1.0,
+            gradient: DVec3::new(0.0, g / s, 0.0),
+            bounds: Bounds::new(DVec3::new(0.0, -s, -s), DVec3::new(2.0 * s, s, s)),
+        };
+        // Adaptive's tolerance is absolute, in position and in T alike
+        // (documented): above s = 1e6 a 1e-10 bound is below f64 round-off
+        // of the position, and scaling it with s loosens T. So the
+        // adaptive scheme is held to 1e-8 … 1e6, fixed-step RK4 (whose
+        // steps scale with the box) to the whole range.
+        let methods: &[Method] =
+            if s <= 1e6 { &[Method::Adaptive, Method::Rk4] } else { &[Method::Rk4] };
+        for &method in methods {
+            let p = match method {
+                Method::Adaptive => TraceParams { step: 1e-2 * s, ..TraceParams::accurate() },
+                _ => TraceParams::fixed(method, 1e-3 * s),
+            };
+            let p = TraceParams { max_length: 10.0 * s, ..p };
+            let r = trace(&f, DVec3::ZERO, DVec3::X / s, &p).unwrap();
+            assert_eq!(r.exit, Exit::Left, "s = {s:e} {method:?}");
+            let rel = |a: f64, b: f64| ((a - b) / b).abs();
+            assert!(rel(r.position.x / s, x) < 1e-12, "s = {s:e}: x {}", r.position.x);
+            assert!(
+                rel(r.position.y / s, y) < 1e-7,
+                "s = {s:e} {method:?}: y/s {}",
+                r.position.y / s
+            );
+            assert!(rel(r.direction.y / r.direction.x, slope) < 1e-7, "s = {s:e}: slope");
+            assert!(rel(r.optical_path / s, opl) < 1e-7, "s = {s:e}: optical path");
+            assert!(r.stats.invariant_drift < 1e-9, "s = {s:e}: drift {}", r.stats.invariant_drift);
+        }
+    }
+}
