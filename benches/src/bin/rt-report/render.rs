@@ -98,7 +98,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         "scene,threads,width,height,ao_samples,seconds,primary_rays,shadow_rays,ao_rays,reflection_rays\n",
     );
     let mut md = String::from(
-        "| threads | AO | seconds | primary | shadow | AO rays | Mrays/s |\n|---|---|---|---|---|---|---|\n",
+        "| threads | AO | seconds (best) | spread | primary | shadow | AO rays | Mrays/s |\n|---|---|---|---|---|---|---|---|\n",
     );
     let mut single = std::collections::HashMap::new();
     let mut verdicts = Vec::new();
@@ -109,15 +109,16 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
                 .num_threads(threads)
                 .build()
                 .map_err(|e| e.to_string())?;
-            // Best of 3 single passes.
-            let mut best = f64::INFINITY;
+            // Best of 3 single passes (1 with --quick).
+            let mut samples = Samples::default();
             let mut counts = None;
             for _ in 0..if quick { 1 } else { 3 } {
                 let mut r = Renderer::new(cam, settings.clone()).map_err(|e| e.to_string())?;
                 let (s, c) = time(|| pool.install(|| r.render_pass(&scene)));
-                best = best.min(s);
+                samples.0.push(s);
                 counts = Some(c);
             }
+            let best = samples.best();
             let c = counts.ok_or("no run")?;
             writeln!(
                 csv,
@@ -131,7 +132,8 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             .unwrap();
             writeln!(
                 md,
-                "| {threads} | {ao} | {best:.3} | {} | {} | {} | {:.2} |",
+                "| {threads} | {ao} | {best:.3} | +{:.0}% | {} | {} | {} | {:.2} |",
+                samples.spread(),
                 c.primary,
                 c.shadow,
                 c.ao,
