@@ -12,7 +12,10 @@ use rt_volume::{
     Bounds, GaussianBump, GrinRod, IndexField, LinearIndex, Luneburg, Method, TraceParams, trace,
 };
 
-use crate::{Section, timing::time};
+use crate::{
+    Section,
+    timing::{Samples, time},
+};
 
 /// A ray launched into a case, with the exact exit point.
 struct Probe {
@@ -98,7 +101,9 @@ fn gaussian() -> (GaussianBump, Vec<Probe>) {
 }
 
 /// One row: (tolerance-or-step, steps, evals, seconds, max error, max drift).
-type Row = (f64, u64, u64, f64, f64, f64);
+/// `(knob, steps/ray, evals/ray, seconds/ray (best of 3), error, drift,
+/// spread %)`.
+type Row = (f64, u64, u64, f64, f64, f64, f64);
 
 /// Runs one parameter setting over a case's probes.
 type Case<'a> = &'a dyn Fn(&TraceParams) -> Row;
@@ -115,17 +120,18 @@ fn sweep<F: IndexField>(field: &F, probes: &[Probe], p: &TraceParams) -> Row {
         }
         (steps, evals, err, drift)
     };
-    // Best of 3 for the time.
-    let mut best = f64::INFINITY;
+    // Best of 3 for the time, with the spread.
+    let mut samples = Samples::default();
     let mut out = (0, 0, 0.0, 0.0);
     for _ in 0..3 {
         let (s, o) = time(run);
-        best = best.min(s);
+        samples.0.push(s);
         out = o;
     }
+    let best = samples.best();
     let n = probes.len() as u64;
     let knob = if p.method == Method::Adaptive { p.tolerance } else { p.step };
-    (knob, out.0 / n, out.1 / n, best / n as f64, out.2, out.3)
+    (knob, out.0 / n, out.1 / n, best / n as f64, out.2, out.3, samples.spread())
 }
 
 fn params(method: Method, quick: bool) -> Vec<TraceParams> {
@@ -191,16 +197,17 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             format!("{case}: endpoint error (y) against seconds per ray (x); euler red, rk4 blue, adaptive green, symplectic purple; rings: Pareto front"),
         ));
         // Headline: cheapest run of each method reaching 1e-4, and the best error.
-        writeln!(md, "\n### {case}\n\n| integrator | evals/ray for error ≤ 1e-4 | best error | drift there |\n|---|---|---|---|").unwrap();
+        writeln!(md, "\n### {case}\n\n| integrator | evals/ray for error ≤ 1e-4 | µs/ray there (best of 3, spread) | best error | drift there |\n|---|---|---|---|---|").unwrap();
         let mut need = Vec::new();
         for (m, rows) in &rows_by_method {
             let cheapest = rows.iter().filter(|r| r.4 <= 1e-4).min_by_key(|r| r.2);
             let best = rows.iter().min_by(|a, b| a.4.total_cmp(&b.4)).expect("rows");
             writeln!(
                 md,
-                "| {} | {} | {:.2e} | {:.1e} |",
+                "| {} | {} | {} | {:.2e} | {:.1e} |",
                 m.name(),
                 cheapest.map_or("—".into(), |r| r.2.to_string()),
+                cheapest.map_or("—".into(), |r| format!("{:.2} (+{:.0}%)", r.3 * 1e6, r.6)),
                 best.4,
                 best.5
             )
