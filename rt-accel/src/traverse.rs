@@ -161,7 +161,11 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 }
             } else {
                 let node = &self.nodes[cur.index()];
-                let (mask, _) = box_test(node, &ctx, t_max);
+                // Widened as in `closest_best`: a box entered at a rounded
+                // distance just past `t_max` may hold a hit at exactly
+                // `t_max` (found by the `bvh` fuzz target with
+                // `t_min = t_max`).
+                let (mask, _) = box_test(node, &ctx, widen_far(t_max));
                 let mut m = mask;
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;

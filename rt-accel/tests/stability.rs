@@ -676,3 +676,40 @@ fn fuzz_regression_pre_split_boxes_hold_whole_triangles() {
         assert_eq!(check_triangles(&bvh, &pos, &idx, &ray), Some((-0.0, 1)), "{quality:?}");
     }
 }
+
+/// Found by the `bvh` fuzz target: a ray with `t_min = t_max = 0.75`
+/// hitting a plane at exactly 0.75. `closest_hit` widened its box bound
+/// and found it; `occluded` culled the box (entered at a rounded 0.75 + ε)
+/// and said no. Both widen the bound now.
+#[test]
+fn fuzz_regression_occluded_at_exactly_t_max() {
+    let pos = vec![
+        Vec3::new(-3.1875, 10000.0, -2.8125),
+        Vec3::new(-2.8125, -2.8125, -2.8125),
+        Vec3::new(10000.0, 2.6875, -2.8125),
+        Vec3::new(-2.8125, 0.5, -2.8125),
+        Vec3::new(2.6875, -2.8125, -2.8125),
+        Vec3::new(-2.8125, 2.6875, 2.4375),
+        Vec3::new(1.0, -2.5625, 2.75),
+        Vec3::new(-0.0, 0.0, -2.8125),
+        Vec3::new(-1.1875, 3.875, 3.875),
+        Vec3::new(2.875, -2.8125, -2.8125),
+        Vec3::new(-2.8125, 3.875, 3.875),
+        Vec3::new(3.875, 3.875, 3.875),
+        Vec3::new(1e-8, 0.0, 0.0),
+        Vec3::new(3.875, -1e-8, 3.875),
+        Vec3::new(1.0, 3.875, 3.875),
+    ];
+    let idx = vec![[0, 1, 2], [2, 4, 5], [6, 7, 8], [9, 10, 11], [12, 13, 14]];
+    let ray = Ray {
+        origin: Vec3::new(3.875, -0.0, 0.0),
+        direction: Vec3::new(0.0, 1.192_092_9e-7, -3.75),
+        t_min: 0.75,
+        t_max: 0.75,
+    };
+    for quality in rt_accel::BuildQuality::ALL {
+        let params = rt_accel::BuildParams { quality, ..rt_accel::BuildParams::medium() };
+        let bvh = build_triangles(&pos, &idx, &params).unwrap();
+        assert_eq!(check_triangles(&bvh, &pos, &idx, &ray), Some((0.75, 0)), "{quality:?}");
+    }
+}
