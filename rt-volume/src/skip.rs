@@ -72,6 +72,10 @@ pub fn trace_skipping(
             let mut hint = usize::MAX;
             // Whether every node so far holds the one constant `value`.
             let (mut uniform, mut value) = (true, None);
+            // A straight line crosses each cell plane at most once: more
+            // moves than that means no progress (bounded work whatever the
+            // grid's geometry).
+            let mut moves_left = cells.iter().sum::<f64>() as usize * 3 + 16;
             // The outer half cells repeat the edge samples (zero slope
             // across the faces), so the edge nodes' statistics cover them
             // too.
@@ -101,10 +105,18 @@ pub fn trace_skipping(
                         leaves = face < 0.0 || face > cells[a];
                     }
                 }
-                if !exit.is_finite() {
+                if !exit.is_finite() || moves_left == 0 {
                     break;
                 }
-                let next = exit.max(t) + tiny;
+                moves_left -= 1;
+                // Past the face by `tiny`, and by at least a few ulps of
+                // `t`: where `t` is huge next to the spacing (found by the
+                // `octree` fuzz target with a 3e38 spacing), `+ tiny` alone
+                // was absorbed and the loop never moved.
+                let next = (exit.max(t) + tiny).max(t + 4.0 * f64::EPSILON * t.abs());
+                if next <= t {
+                    break;
+                }
                 bound += f64::from(node.stats.grad_max) * (next - t);
                 t = next;
                 let (lo, hi) = (node.stats.min, node.stats.max);
@@ -127,6 +139,44 @@ pub fn trace_skipping(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Found by the `octree` fuzz target: with a cell spacing of 3.4e38
+    /// along x, `t + tiny` was absorbed by rounding and the node walk
+    /// never moved (a hang). It must finish, here within 10 s.
+    #[test]
+    fn fuzz_regression_huge_spacing_does_not_hang() {
+        extern crate std;
+        let mut data = alloc::vec![0.999f32; 72];
+        for (i, v) in [(34, 1.096), (67, 1.1), (68, 1.0), (69, 1.054), (70, 1.0), (71, 1.0)] {
+            data[i] = v;
+        }
+        let grid = crate::Grid::new(
+            [2, 6, 6],
+            DVec3::splat(0.1),
+            DVec3::new(3.402_823_466_385_288_6e38, 3.875, 3.875),
+            data,
+        )
+        .unwrap();
+        let field = GridField::new(grid, Interp::Trilinear, 1.0).unwrap();
+        let tree = build_octree(&field).unwrap();
+        let params = TraceParams {
+            method: crate::Method::Symplectic,
+            step: 3.875,
+            tolerance: 3.875,
+            max_step: 3.875,
+            max_steps: 2705,
+            max_length: 0.01,
+        };
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let o = DVec3::new(-1.401_298_464_324_817e-45, 0.625, 1.192_092_895_507_812_5e-7);
+            let d = DVec3::new(3.875, 0.0, 1.192_092_895_507_812_5e-7);
+            let r = trace_skipping(&field, &tree, o, d, &params, 3.1875);
+            tx.send(r.map(|r| r.position.is_finite())).ok();
+        });
+        let r = rx.recv_timeout(core::time::Duration::from_secs(10)).expect("finished");
+        assert!(r.unwrap_or(true), "a non-finite position");
+    }
     use crate::{Grid, Method};
 
     #[test]
