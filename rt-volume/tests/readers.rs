@@ -7,17 +7,27 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use rt_volume::io::{ReadError, parse_nrrd, read_grid};
 
+/// The repository's copy of the project's real CFD data (the main job
+/// embeds it): raw payload, JSON sidecar and a detached NRRD header.
 fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../benches/data").join(name)
 }
 
-/// The blast wave through both formats: same geometry and samples, the
-/// statistics its provenance records (min, max, mean).
+/// The blast wave through every form: detached NRRD header, the same header
+/// with the payload attached (as the original `.nrrd` file has it), and raw
+/// + JSON: same geometry and samples, the statistics its provenance records
+/// (min, max, mean).
 #[test]
 fn blast_wave_reads_identically_from_nrrd_and_raw_json() {
-    let a = read_grid(&data("blast_sedov_64.nrrd")).expect("nrrd");
+    let a = read_grid(&data("blast_sedov_64.nhdr")).expect("detached nrrd");
     let b = read_grid(&data("blast_sedov_64.json")).expect("raw + json");
     assert_eq!(a, b);
+    let header = std::fs::read_to_string(data("blast_sedov_64.nhdr")).unwrap();
+    let header: String =
+        header.lines().filter(|l| !l.starts_with("data file")).map(|l| format!("{l}\n")).collect();
+    let mut attached = header.into_bytes();
+    attached.extend(std::fs::read(data("blast_sedov_64.raw")).unwrap());
+    assert_eq!(parse_nrrd(&attached, None).expect("attached nrrd"), a);
     assert_eq!(a.dims(), [64, 64, 64]);
     assert_eq!(a.spacing(), DVec3::splat(0.015625));
     assert_eq!(a.origin(), DVec3::splat(-0.4921875));
