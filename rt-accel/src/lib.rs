@@ -58,7 +58,6 @@ pub mod io;
 #[cfg(feature = "alloc")]
 mod mesh;
 mod node;
-mod octree;
 mod prim;
 mod ray_ctx;
 #[cfg(feature = "alloc")]
@@ -80,9 +79,6 @@ pub use error::{BuildError, LoadError};
 #[cfg(feature = "alloc")]
 pub use mesh::TriangleMesh;
 pub use node::{ChildRef, GROUPS, MAX_ITEMS, MAX_LEAF_ITEMS, Node, WIDTH};
-#[cfg(feature = "alloc")]
-pub use octree::Octree;
-pub use octree::{BRICK, OctNode, OctreeError, SmoothNode};
 pub use prim::{BestHit, CapsuleItem, Primitive, SphereItem};
 pub use ray_ctx::RayCtx;
 #[cfg(feature = "alloc")]

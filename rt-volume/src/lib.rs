@@ -20,7 +20,7 @@
 //! | feature | default | what it does |
 //! |---|---|---|
 //! | `std` | yes | std float functions; implies `alloc` |
-//! | `alloc` | via `std` | gridded fields ([`Grid`], [`GridField`]) |
+//! | `alloc` | via `std` | gridded fields ([`Grid`], [`GridField`]) and [`skip`]ping ([`Octree`], [`trace_skipping`], [`BeamMask`]) |
 //! | `libm` | no | float functions from `libm` for `no_std` |
 //! | `io` | no | readers ([`io`]): raw + JSON header, NRRD |
 //!
@@ -46,8 +46,6 @@ extern crate alloc;
 extern crate std;
 
 mod analytic;
-#[cfg(feature = "alloc")]
-mod beam;
 mod field;
 #[cfg(feature = "alloc")]
 mod grid;
@@ -56,22 +54,21 @@ pub mod io;
 mod mapping;
 mod math;
 #[cfg(feature = "alloc")]
-mod skip;
+pub mod skip;
 mod trace;
 
 pub use analytic::{
     Constant, FnField, GaussianBump, GrinRod, LinearIndex, LinearSquared, Luneburg,
 };
-#[cfg(feature = "alloc")]
-pub use beam::{BeamMask, BeamWindow, MAX_BEAM_CELLS, trace_beam};
 pub use field::{Bounds, IndexField};
 #[cfg(feature = "alloc")]
 pub use grid::{Grid, GridError, GridField, Interp};
 pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
 #[cfg(feature = "alloc")]
-pub use rt_accel::Octree;
-#[cfg(feature = "alloc")]
-pub use skip::{build_octree, trace_skipping};
+pub use skip::{
+    BRICK, BeamMask, BeamWindow, MAX_BEAM_CELLS, OctNode, Octree, OctreeError, SmoothNode,
+    build_octree, trace_beam, trace_skipping,
+};
 pub use trace::{
     Exit, Method, TraceError, TraceParams, TraceResult, TraceStats, trace, trace_visiting,
 };

@@ -4,11 +4,11 @@
 use alloc::vec::Vec;
 
 use glam::DVec3;
-use rt_accel::Octree;
 
+use super::{Octree, trace_skipping};
 use crate::{
     Bounds, Exit, GridField, IndexField, Interp, TraceError, TraceParams, TraceResult, TraceStats,
-    trace::check_params, trace_skipping,
+    trace::check_params,
 };
 
 /// A collimated beam's cross-section, divided into cells (e.g. one per

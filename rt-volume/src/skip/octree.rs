@@ -15,14 +15,15 @@
 //! `∫|∇⊥n|/n ds ≤ max|∇n| · diagonal / min n`, so `tolerance` is the
 //! deflection (radians, for `n ≈ 1`) allowed per skipped node.
 
-#[cfg(feature = "alloc")]
 use alloc::vec::Vec;
+
+use crate::math::sqrt;
 
 /// Dual cells per brick edge.
 pub const BRICK: usize = 4;
 
 /// Statistics of one octree node.
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct OctNode {
     /// Smallest value covered.
@@ -33,7 +34,6 @@ pub struct OctNode {
     pub grad_max: f32,
 }
 
-#[cfg(feature = "alloc")]
 impl OctNode {
     const EMPTY: Self = Self { min: f32::INFINITY, max: f32::NEG_INFINITY, grad_max: 0.0 };
 
@@ -62,7 +62,6 @@ pub struct SmoothNode {
 
 /// The octree (see the module docs).
 #[derive(Clone, Debug, PartialEq)]
-#[cfg(feature = "alloc")]
 pub struct Octree {
     /// Bricks per edge at the finest level (a power of two).
     side: usize,
@@ -96,7 +95,6 @@ impl core::fmt::Display for OctreeError {
 
 impl core::error::Error for OctreeError {}
 
-#[cfg(feature = "alloc")]
 impl Octree {
     /// Builds the octree over `samples` (x fastest) of a `dims` grid with
     /// the given spacing.
@@ -269,7 +267,6 @@ impl Octree {
     }
 }
 
-#[cfg(feature = "alloc")]
 impl Octree {
     /// Covers the cells with the largest smooth nodes (the ones
     /// [`Octree::smooth_node`] returns) and the bricks that are not smooth,
@@ -306,20 +303,6 @@ impl Octree {
             self.partition_at(l - 1, child, tolerance, f);
         }
     }
-}
-
-#[cfg(feature = "alloc")]
-fn sqrt(x: f64) -> f64 {
-    // Newton's method seeded by the f32 root: enough for a bound, and
-    // keeps the module free of std/libm.
-    if x <= 0.0 {
-        return 0.0;
-    }
-    let mut r = f64::from(f32::from_bits((x as f32).to_bits() / 2 + 0x1fbd_1df5)).max(1e-300);
-    for _ in 0..6 {
-        r = 0.5 * (r + x / r);
-    }
-    r
 }
 
 #[cfg(test)]

@@ -2,18 +2,18 @@
 //! straight step each.
 
 use glam::DVec3;
-use rt_accel::Octree;
 
+use super::{Octree, OctreeError};
 use crate::{
     GridField, Interp, TraceError, TraceParams, TraceResult,
     trace::{Skip, trace_impl},
 };
 
-/// An octree over a gridded field's samples (see [`rt_accel::Octree`]).
+/// An octree over a gridded field's samples (see [`Octree`]).
 ///
 /// # Errors
-/// [`rt_accel::OctreeError`] for grids with fewer than 2 samples per axis.
-pub fn build_octree(field: &GridField) -> Result<Octree, rt_accel::OctreeError> {
+/// [`OctreeError`] for grids with fewer than 2 samples per axis.
+pub fn build_octree(field: &GridField) -> Result<Octree, OctreeError> {
     let g = field.grid();
     Octree::build(g.dims(), g.data(), g.spacing().to_array())
 }
