@@ -22,19 +22,18 @@ use criterion::{
 };
 use glam::{Vec2, Vec3};
 use rayon::ThreadPool;
-use rt_accel::{BuildParams, Glyphs, Paint, SurfaceScene, TriangleMesh};
+use rt_accel::{BuildParams, TriangleMesh};
 use rt_benches::scenes::{self, knife_bench, sparse_bumps};
-use rt_core::{
-    Camera, Light, Material, Projection, Renderer, SceneQuery, Settings, intersect::Sphere,
-};
+use rt_core::{Camera, Projection, SceneQuery, intersect::Sphere};
 use rt_photo::{Film, Filter};
+use rt_surface::{Glyphs, Light, Material, Paint, Renderer, Settings, SurfaceScene};
 use rt_volume::{TraceParams, build_octree, trace, trace_skipping};
 
 const SIZE: u32 = 128;
 
 fn world(mirror: f32) -> SurfaceScene<'static> {
     let t = scenes::terrain(129);
-    let mesh = TriangleMesh::new(t.positions, t.indices, None).expect("terrain");
+    let mesh = TriangleMesh::new(t.positions, t.indices).expect("terrain");
     let spheres = (0..12)
         .map(|i| {
             let a = i as f32 / 12.0 * std::f32::consts::TAU;
@@ -48,7 +47,7 @@ fn world(mirror: f32) -> SurfaceScene<'static> {
         material: Material { mirror, ..Material::GLOSSY },
     };
     SurfaceScene::build(
-        vec![(mesh, Paint::Solid([0.7; 3]), Material::MATTE)],
+        vec![(mesh.into(), Paint::Solid([0.7; 3]), Material::MATTE)],
         vec![glyphs],
         vec![],
         &BuildParams::medium(),
@@ -125,9 +124,9 @@ fn skips(c: &mut Criterion) {
 
     let t = scenes::terrain(257);
     let moved: Vec<Vec3> = t.positions.iter().map(|p| *p + Vec3::new(0.0, 0.01, 0.0)).collect();
-    let mesh = TriangleMesh::new(t.positions.clone(), t.indices.clone(), None).expect("terrain");
+    let mesh = TriangleMesh::new(t.positions.clone(), t.indices.clone()).expect("terrain");
     let mut s = SurfaceScene::build(
-        vec![(mesh.clone(), Paint::Solid([0.7; 3]), Material::MATTE)],
+        vec![(mesh.clone().into(), Paint::Solid([0.7; 3]), Material::MATTE)],
         vec![],
         vec![],
         &BuildParams::medium(),
@@ -136,7 +135,9 @@ fn skips(c: &mut Criterion) {
     let mut g = c.benchmark_group("skip_moving_mesh_131k");
     g.sample_size(20);
     g.bench_function("refit", |b| b.iter(|| s.set_mesh_positions(0, &moved).expect("refit")));
-    g.bench_function("rebuild", |b| b.iter(|| s.replace_mesh(0, mesh.clone()).expect("rebuild")));
+    g.bench_function("rebuild", |b| {
+        b.iter(|| s.replace_mesh(0, mesh.clone().into()).expect("rebuild"))
+    });
     g.finish();
 
     let f = sparse_bumps();

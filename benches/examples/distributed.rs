@@ -30,10 +30,11 @@
 use std::{path::PathBuf, process::ExitCode, time::Instant};
 
 use glam::Vec3;
-use rt_accel::{BuildParams, Paint, SurfaceScene, TriangleMesh};
+
 use rt_benches::{image::write_png, scenes};
 use rt_composite::{Communicator, Mode, Schedule, composite};
-use rt_core::{Camera, ColorMap, Frame, Light, Material, Pixel, Projection, Renderer, Settings};
+use rt_core::{Camera, ColorMap, Frame, Pixel, Projection};
+use rt_surface::{Light, Mesh, Paint, Renderer, Settings, SurfaceScene};
 
 const USAGE: &str = "usage: distributed [--ranks N] [--size WxH] [--grid N] \
 [--schedule direct-send|binary-swap|radix-K] [--out PATH]";
@@ -98,19 +99,18 @@ fn parse_args(args: impl Iterator<Item = String>) -> Result<Options, String> {
 }
 
 /// The whole terrain, coloured by height, and the colour map's range.
-fn terrain(grid: u32) -> Result<(TriangleMesh, (f32, f32)), String> {
+fn terrain(grid: u32) -> Result<(Mesh, (f32, f32)), String> {
     let t = scenes::terrain(grid);
     let heights: Vec<f32> = t.positions.iter().map(|p| p.y).collect();
     let range = heights.iter().fold((f32::MAX, f32::MIN), |(a, b), &h| (a.min(h), b.max(h)));
-    let mesh =
-        TriangleMesh::new(t.positions, t.indices, Some(heights)).map_err(|e| e.to_string())?;
+    let mesh = Mesh::new(t.positions, t.indices, Some(heights)).map_err(|e| e.to_string())?;
     Ok((mesh, range))
 }
 
 /// Slab `rank` of `ranks`: the triangles whose centroids fall in that
 /// share of the order along the mesh's longest axis, with only the
 /// vertices they use (values copied, so shading is unchanged).
-fn share(mesh: &TriangleMesh, rank: usize, ranks: usize) -> Result<TriangleMesh, String> {
+fn share(mesh: &Mesh, rank: usize, ranks: usize) -> Result<Mesh, String> {
     let (p, idx) = (mesh.positions(), mesh.indices());
     let (lo, hi) = p.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
     let axis = (hi - lo).max_position();
@@ -132,20 +132,14 @@ fn share(mesh: &TriangleMesh, rank: usize, ranks: usize) -> Result<TriangleMesh,
             remap[v]
         }));
     }
-    TriangleMesh::new(positions, indices, Some(scalars)).map_err(|e| e.to_string())
+    Mesh::new(positions, indices, Some(scalars)).map_err(|e| e.to_string())
 }
 
 /// One sample at each pixel centre of `mesh`, lit locally.
-fn render(mesh: TriangleMesh, range: (f32, f32), size: (u32, u32)) -> Result<Frame, String> {
+fn render(mesh: Mesh, range: (f32, f32), size: (u32, u32)) -> Result<Frame, String> {
     let paint =
         Paint::Mapped(ColorMap::viridis().with_range(range.0, range.1).map_err(|e| e.to_string())?);
-    let world = SurfaceScene::build(
-        vec![(mesh, paint, Material::MATTE)],
-        vec![],
-        vec![],
-        &BuildParams::medium(),
-    )
-    .map_err(|e| e.to_string())?;
+    let world = SurfaceScene::from_mesh(mesh, paint).map_err(|e| e.to_string())?;
     let cam = Camera::look_at(
         Vec3::new(1.5, 1.3, 2.1),
         Vec3::new(0.0, 0.1, 0.0),

@@ -35,9 +35,9 @@ use std::{path::PathBuf, process::ExitCode, time::Instant};
 
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
-use rt_accel::{BuildParams, Paint, SurfaceScene, io::read_mesh};
 use rt_benches::image::write_png;
-use rt_core::{Camera, ColorMap, Light, Material, Projection, Renderer, Settings};
+use rt_core::{Camera, ColorMap, Projection};
+use rt_surface::{Light, Paint, Renderer, Settings, SurfaceScene, io::read_mesh};
 
 const USAGE: &str = "usage: view FILE [--out PATH] [--scalar NAME] [--colormap viridis|cool-to-warm|grayscale] \
 [--range LO,HI] [--color R,G,B] [--ao N] [--ao-distance D] [--shadows] [--size WxH] [--passes N] \
@@ -157,7 +157,7 @@ fn main() -> ExitCode {
 
 fn run(o: &Options) -> Result<(), String> {
     let t0 = Instant::now();
-    let data = read_mesh(&o.file).map_err(|e| format!("{}: {e}", o.file.display()))?;
+    let data = read_mesh(&o.file).map_err(|e| e.to_string())?;
     if o.list {
         println!(
             "{}: {} vertices, {} triangles",
@@ -172,7 +172,8 @@ fn run(o: &Options) -> Result<(), String> {
         }
         return Ok(());
     }
-    let mesh = data.into_mesh(o.scalar.as_deref()).map_err(|e| e.to_string())?;
+    let mesh =
+        data.into_mesh(o.scalar.as_deref()).map_err(|e| format!("{}: {e}", o.file.display()))?;
     if mesh.indices().is_empty() {
         return Err(format!("{}: no triangles to render", o.file.display()));
     }
@@ -196,13 +197,7 @@ fn run(o: &Options) -> Result<(), String> {
     let center = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(f32::MIN_POSITIVE);
     let triangles = mesh.indices().len();
-    let world = SurfaceScene::build(
-        vec![(mesh, paint, Material::MATTE)],
-        vec![],
-        vec![],
-        &BuildParams::medium(),
-    )
-    .map_err(|e| e.to_string())?;
+    let world = SurfaceScene::from_mesh(mesh, paint).map_err(|e| e.to_string())?;
     let built = t0.elapsed();
 
     let (w, h) = o.size;

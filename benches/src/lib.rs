@@ -5,5 +5,4 @@
 
 pub mod image;
 pub mod plot;
-pub mod ply;
 pub mod scenes;

@@ -1,12 +1,14 @@
-//! The film from any size, filter and photons: off-film and non-finite
-//! positions are counted as lost, never splatted; with finite weights and
-//! deflections every pixel stays finite and the deposited total equals
-//! the weight of the photons that landed (each filter's shares sum to 1).
+//! The film from any size, filter and photons: only empty films and wide
+//! tents of a NaN, infinite or sub-pixel radius are refused; off-film and
+//! non-finite positions are counted as lost, never splatted; with finite
+//! weights and deflections every pixel stays finite and the deposited
+//! total equals the weight of the photons that landed (each filter's
+//! shares sum to 1).
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use rt_fuzz::{f32_any, f64_any};
-use rt_photo::{Film, Filter};
+use rt_photo::{Film, FilmError, Filter};
 
 fuzz_target!(|data: &[u8]| {
     let mut u = arbitrary::Unstructured::new(data);
@@ -24,9 +26,18 @@ fuzz_target!(|data: &[u8]| {
         2 => Filter::WideTent { radius },
         _ => Filter::adaptive(radius),
     };
-    let Ok(mut film) = Film::new(w, h, filter) else {
-        assert!(w == 0 || h == 0, "a {w}×{h} film refused");
-        return;
+    let mut film = match Film::new(w, h, filter) {
+        Ok(film) => film,
+        Err(FilmError::ZeroSize { .. }) => {
+            assert!(w == 0 || h == 0, "a {w}×{h} film refused as empty");
+            return;
+        }
+        Err(FilmError::BadFilterRadius(r)) => {
+            // `Filter::adaptive` always gives a valid radius.
+            assert!(kind == 2 && !(r.is_finite() && r >= 1.0), "radius {r} refused");
+            return;
+        }
+        Err(e) => panic!("a {w}×{h} film refused: {e}"),
     };
     let (mut landed, mut finite) = (0.0f64, true);
     let mut expected_lost = 0;

@@ -5,7 +5,7 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    if let Ok(m) = rt_accel::io::parse_obj(data) {
+    if let Ok(m) = rt_surface::io::parse_obj(data) {
         rt_fuzz::check_mesh(m);
     }
 });

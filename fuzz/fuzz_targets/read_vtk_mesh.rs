@@ -6,9 +6,9 @@ use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     let parsed = if data.first() == Some(&b'<') {
-        rt_accel::io::parse_vtk_xml(data)
+        rt_surface::io::parse_vtk_xml(data)
     } else {
-        rt_accel::io::parse_vtk_legacy(data)
+        rt_surface::io::parse_vtk_legacy(data)
     };
     if let Ok(m) = parsed {
         rt_fuzz::check_mesh(m);

@@ -155,7 +155,7 @@ pub fn check_grid(g: &rt_volume::Grid) {
 /// A mesh a reader returned: every index points at a vertex, every
 /// normal and scalar array has one value per vertex; and building the
 /// mesh either works or is an `Err`.
-pub fn check_mesh(m: rt_accel::io::MeshData) {
+pub fn check_mesh(m: rt_surface::io::MeshData) {
     let n = m.positions.len();
     assert!(m.indices.iter().flatten().all(|&i| (i as usize) < n), "index past {n} vertices");
     if let Some(normals) = &m.normals {
@@ -166,7 +166,7 @@ pub fn check_mesh(m: rt_accel::io::MeshData) {
     }
     let first = m.scalars.first().map(|(name, _)| name.clone());
     if let Ok(mesh) = m.into_mesh(first.as_deref()) {
-        let _ = mesh.build_bvh(&rt_accel::BuildParams::fast());
+        let _ = mesh.geometry().build_bvh(&rt_accel::BuildParams::fast());
     }
 }
 

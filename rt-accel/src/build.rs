@@ -174,7 +174,8 @@ pub fn build_triangles(
 
 impl crate::TriangleMesh {
     /// Builds a BVH over the mesh ([`build_triangles`]); hits carry the
-    /// triangle index and barycentrics for [`crate::TriangleMesh::interpolate_scalar`].
+    /// triangle index and the barycentrics of the hit point (for
+    /// interpolating per-vertex data).
     ///
     /// # Errors
     /// As [`build_triangles`] (a validated mesh only fails on size limits).

@@ -98,7 +98,11 @@ impl<P: Primitive> Bvh<P> {
         max
     }
 
-    /// The serialized form: header, nodes, items (native byte order).
+    /// The serialized form: header, nodes, items (native byte order), in
+    /// a plain `Vec` (1-byte alignment promised: load it with
+    /// [`Bvh::from_bytes`], which copies, or use
+    /// [`Bvh::to_aligned_bytes`] to view it in place with
+    /// [`BvhRef::from_bytes`](crate::BvhRef::from_bytes)).
     #[must_use]
     pub fn to_bytes(&self) -> Vec<u8> {
         let h = Header::new::<P>(self.nodes.len(), self.items.len(), self.prim_count);
@@ -111,6 +115,13 @@ impl<P: Primitive> Bvh<P> {
         out.extend_from_slice(bytemuck::cast_slice(&self.nodes));
         out.extend_from_slice(bytemuck::cast_slice(&self.items));
         out
+    }
+
+    /// [`Bvh::to_bytes`] in [`AlignedBytes`](crate::AlignedBytes): ready for
+    /// zero-copy viewing with [`BvhRef::from_bytes`](crate::BvhRef::from_bytes).
+    #[must_use]
+    pub fn to_aligned_bytes(&self) -> crate::AlignedBytes {
+        crate::AlignedBytes::copy_from(&self.to_bytes())
     }
 
     /// Loads a serialized BVH from any byte buffer (copying into aligned

@@ -86,8 +86,11 @@ pub(crate) fn parse<P: Primitive>(
 }
 
 impl<'a, P: Primitive> BvhRef<'a, P> {
-    /// Borrows a serialized BVH without copying. The bytes must be 16-byte
-    /// aligned (use [`crate::Bvh::from_bytes`] to load from any buffer).
+    /// Borrows a serialized BVH without copying. The bytes must start on a
+    /// 16-byte boundary (`align_of::<Node>()`): [`crate::AlignedBytes`]
+    /// (from [`crate::Bvh::to_aligned_bytes`], or a copy of bytes read
+    /// elsewhere) always does; a `Vec<u8>` need not. Use
+    /// [`crate::Bvh::from_bytes`] to load from any buffer by copying.
     ///
     /// # Errors
     /// [`LoadError`] naming the first problem found.

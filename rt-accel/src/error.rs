@@ -23,25 +23,6 @@ pub enum BuildError {
         /// Index of the primitive.
         index: usize,
     },
-    /// A per-vertex scalar array does not have one value per vertex.
-    ScalarCountMismatch {
-        /// Number of vertices.
-        vertices: usize,
-        /// Number of scalars.
-        scalars: usize,
-    },
-    /// A per-vertex normal array does not have one normal per vertex.
-    NormalCountMismatch {
-        /// Number of vertices.
-        vertices: usize,
-        /// Number of normals.
-        normals: usize,
-    },
-    /// A vertex normal is NaN, infinite or zero.
-    BadNormal {
-        /// Index of the vertex.
-        vertex: usize,
-    },
     /// Refit data do not match the BVH (different primitive count).
     RefitMismatch,
     /// More primitives than the node layout can address (2²⁷ leaf items).
@@ -59,15 +40,6 @@ impl fmt::Display for BuildError {
             }
             Self::InvalidPrimitive { index } => {
                 write!(f, "primitive {index} is not finite or has a non-positive radius")
-            }
-            Self::ScalarCountMismatch { vertices, scalars } => {
-                write!(f, "{scalars} scalars given for {vertices} vertices")
-            }
-            Self::NormalCountMismatch { vertices, normals } => {
-                write!(f, "{normals} normals given for {vertices} vertices")
-            }
-            Self::BadNormal { vertex } => {
-                write!(f, "normal of vertex {vertex} is not finite or zero")
             }
             Self::RefitMismatch => write!(f, "refit data do not match the BVH's primitives"),
             Self::TooManyPrimitives => write!(f, "too many primitives for one BVH"),

@@ -19,9 +19,8 @@
 //! | feature | default | what it does |
 //! |---|---|---|
 //! | `std` | yes | std float functions; implies `alloc` |
-//! | `alloc` | via `std` | owned [`Bvh`], [`Scene`], [`TriangleMesh`], copying loader, refit |
-//! | `obvhs` | yes | building ([`build_triangles`], [`build_spheres`], [`build_capsules`], [`SurfaceScene`]); needs std |
-//! | `io` | no | mesh readers (module `io`): OBJ, PLY with scalars, VTK polydata; needs std |
+//! | `alloc` | via `std` | owned [`Bvh`], [`Scene`], [`TriangleMesh`], [`AlignedBytes`], copying loader, refit |
+//! | `obvhs` | yes | building ([`build_triangles`], [`build_spheres`], [`build_capsules`]); needs std |
 //! | `libm` | no | float functions from `libm` for `no_std` |
 //!
 //! ## Example
@@ -33,10 +32,14 @@
 //! let bvh = build_triangles(&positions, &[[0, 1, 2]], &BuildParams::medium()).unwrap();
 //! let hit = bvh.closest_hit(&Ray::new(Vec3::new(0.0, 0.0, 3.0), Vec3::NEG_Z)).unwrap();
 //! assert_eq!((hit.t, hit.prim), (3.0, 0));
-//! // Round trip through bytes.
+//! // Round trip through bytes: copied into a new BVH, or viewed in place
+//! // (zero-copy needs aligned bytes, which `to_aligned_bytes` gives).
 //! let bytes = bvh.to_bytes();
 //! let loaded = rt_accel::Bvh::<rt_accel::TriPacket>::from_bytes(&bytes).unwrap();
 //! assert_eq!(loaded, bvh);
+//! let aligned = bvh.to_aligned_bytes();
+//! let view = rt_accel::BvhRef::<rt_accel::TriPacket>::from_bytes(&aligned).unwrap();
+//! assert_eq!(view.closest_hit(&Ray::new(Vec3::new(0.0, 0.0, 3.0), Vec3::NEG_Z)), Some(hit));
 //! ```
 #![no_std]
 
@@ -45,6 +48,8 @@ extern crate alloc;
 #[cfg(feature = "std")]
 extern crate std;
 
+#[cfg(feature = "alloc")]
+mod aligned;
 #[cfg(feature = "obvhs")]
 mod build;
 #[cfg(feature = "alloc")]
@@ -53,8 +58,6 @@ mod bytes;
 #[cfg(feature = "alloc")]
 mod check;
 mod error;
-#[cfg(feature = "io")]
-pub mod io;
 #[cfg(feature = "alloc")]
 mod mesh;
 mod node;
@@ -65,11 +68,11 @@ mod refit;
 #[cfg(feature = "alloc")]
 mod scene;
 mod simd;
-#[cfg(feature = "obvhs")]
-mod surface;
 mod traverse;
 mod tri_packet;
 
+#[cfg(feature = "alloc")]
+pub use aligned::{AlignedBytes, BYTES_ALIGN};
 #[cfg(feature = "obvhs")]
 pub use build::{BuildParams, BuildQuality, build_capsules, build_spheres, build_triangles};
 #[cfg(feature = "alloc")]
@@ -83,7 +86,10 @@ pub use prim::{BestHit, CapsuleItem, Primitive, SphereItem};
 pub use ray_ctx::RayCtx;
 #[cfg(feature = "alloc")]
 pub use scene::Scene;
-#[cfg(feature = "obvhs")]
-pub use surface::{Glyphs, Paint, SceneError, SurfaceScene, Tube};
 pub use traverse::{BvhRef, MAX_DEPTH, STACK_SIZE, TraversalStack, TraversalStats};
 pub use tri_packet::TriPacket;
+
+/// The crate README's example, compiled and run as a doc test.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -1,9 +1,9 @@
-//! Triangle meshes with optional per-vertex scalars.
+//! Indexed triangle meshes: plain, validated geometry for building and
+//! refitting triangle BVHs.
 
 use alloc::{collections::BTreeMap, vec::Vec};
 
 use glam::Vec3;
-use rt_core::{Hit, PrimKind};
 
 use crate::BuildError;
 
@@ -12,24 +12,17 @@ use crate::BuildError;
 pub struct TriangleMesh {
     positions: Vec<Vec3>,
     indices: Vec<[u32; 3]>,
-    scalars: Option<Vec<f32>>,
-    normals: Option<Vec<Vec3>>,
 }
 
 impl TriangleMesh {
-    /// A mesh from vertex positions, triangles (counter-clockwise front
-    /// faces) and optional per-vertex scalars.
+    /// A mesh from vertex positions and triangles (counter-clockwise front
+    /// faces).
     ///
     /// # Errors
-    /// [`BuildError::NonFiniteVertex`] for the first NaN/∞ vertex,
-    /// [`BuildError::IndexOutOfRange`], or
-    /// [`BuildError::ScalarCountMismatch`]. Scalars may be NaN (they map to
-    /// the colour map's NaN colour).
-    pub fn new(
-        positions: Vec<Vec3>,
-        indices: Vec<[u32; 3]>,
-        scalars: Option<Vec<f32>>,
-    ) -> Result<Self, BuildError> {
+    /// [`BuildError::NonFiniteVertex`] for the first NaN/∞ vertex, or
+    /// [`BuildError::IndexOutOfRange`] for the first triangle naming a
+    /// vertex that does not exist.
+    pub fn new(positions: Vec<Vec3>, indices: Vec<[u32; 3]>) -> Result<Self, BuildError> {
         if let Some(vertex) = positions.iter().position(|p| !p.is_finite()) {
             return Err(BuildError::NonFiniteVertex { vertex });
         }
@@ -38,15 +31,7 @@ impl TriangleMesh {
                 return Err(BuildError::IndexOutOfRange { triangle, index });
             }
         }
-        if let Some(s) = &scalars
-            && s.len() != positions.len()
-        {
-            return Err(BuildError::ScalarCountMismatch {
-                vertices: positions.len(),
-                scalars: s.len(),
-            });
-        }
-        Ok(Self { positions, indices, scalars, normals: None })
+        Ok(Self { positions, indices })
     }
 
     /// The unit sphere as an icosahedron subdivided `level` times
@@ -58,7 +43,9 @@ impl TriangleMesh {
     #[must_use]
     pub fn icosphere(level: u32) -> Self {
         assert!(level <= 10, "icosphere level {level} is too fine");
-        let t = (1.0 + 5.0f32.sqrt()) / 2.0;
+        // The golden ratio (1 + √5) / 2, rounded to f32 as the computed
+        // value is (no float functions needed without std).
+        let t = 1.618_034_f32;
         let base = [
             (-1.0, t, 0.0),
             (1.0, t, 0.0),
@@ -115,46 +102,7 @@ impl TriangleMesh {
             }
             indices = next;
         }
-        Self { positions, indices, scalars: None, normals: None }
-    }
-
-    /// The mesh with per-vertex shading normals (any non-zero length).
-    ///
-    /// # Errors
-    /// [`BuildError::NormalCountMismatch`] unless there is one per vertex,
-    /// [`BuildError::BadNormal`] for the first NaN/∞ or zero normal.
-    pub fn with_normals(mut self, normals: Vec<Vec3>) -> Result<Self, BuildError> {
-        if normals.len() != self.positions.len() {
-            return Err(BuildError::NormalCountMismatch {
-                vertices: self.positions.len(),
-                normals: normals.len(),
-            });
-        }
-        if let Some(vertex) = normals.iter().position(|n| !n.is_finite() || *n == Vec3::ZERO) {
-            return Err(BuildError::BadNormal { vertex });
-        }
-        self.normals = Some(normals);
-        Ok(self)
-    }
-
-    /// Per-vertex normals, if any.
-    #[must_use]
-    pub fn normals(&self) -> Option<&[Vec3]> {
-        self.normals.as_deref()
-    }
-
-    /// The shading normal at a triangle hit: the vertex normals
-    /// interpolated with the hit's barycentrics and normalised, or the
-    /// geometric normal without normals (or where they cancel).
-    #[must_use]
-    pub fn shading_normal(&self, hit: &Hit) -> Vec3 {
-        let interpolated = self.normals.as_ref().and_then(|n| {
-            let [i0, i1, i2] = *self.indices.get(hit.prim as usize)?;
-            let (b1, b2) = (hit.uv.x, hit.uv.y);
-            let v = (1.0 - b1 - b2) * n[i0 as usize] + b1 * n[i1 as usize] + b2 * n[i2 as usize];
-            v.try_normalize()
-        });
-        interpolated.unwrap_or(hit.normal)
+        Self { positions, indices }
     }
 
     /// Vertex positions.
@@ -167,12 +115,6 @@ impl TriangleMesh {
     #[must_use]
     pub fn indices(&self) -> &[[u32; 3]] {
         &self.indices
-    }
-
-    /// Per-vertex scalars, if any.
-    #[must_use]
-    pub fn scalars(&self) -> Option<&[f32]> {
-        self.scalars.as_deref()
     }
 
     /// Replaces the positions (same count) for animation; follow with
@@ -190,20 +132,5 @@ impl TriangleMesh {
         }
         self.positions.copy_from_slice(positions);
         Ok(())
-    }
-
-    /// The scalar at a triangle hit, interpolated with the hit's
-    /// barycentrics (interpolate the scalar, then colour-map it). `None`
-    /// without scalars or for a hit on another kind or triangle index.
-    #[must_use]
-    pub fn interpolate_scalar(&self, hit: &Hit) -> Option<f32> {
-        if hit.kind != PrimKind::Triangle {
-            return None;
-        }
-        let s = self.scalars.as_ref()?;
-        let [i0, i1, i2] = *self.indices.get(hit.prim as usize)?;
-        let (b1, b2) = (hit.uv.x, hit.uv.y);
-        let b0 = 1.0 - b1 - b2;
-        Some(b0 * s[i0 as usize] + b1 * s[i1 as usize] + b2 * s[i2 as usize])
     }
 }

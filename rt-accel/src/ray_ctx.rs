@@ -1,6 +1,10 @@
 //! Per-ray constants shared by the box tests and the leaf tests.
 
-use rt_core::{Ray, SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG, intersect::WatertightRay};
+use rt_core::{
+    Ray,
+    internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG},
+    intersect::WatertightRay,
+};
 
 use crate::simd::F32x4;
 

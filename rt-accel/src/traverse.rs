@@ -1,7 +1,7 @@
 //! Closest-hit and occlusion traversal of a borrowed BVH: no std, no
 //! allocation, a fixed stack.
 
-use rt_core::{Aabb, Hit, Ray, SceneQuery, widen_far};
+use rt_core::{Aabb, Hit, Ray, SceneQuery, internal::widen_far};
 
 use crate::{
     RayCtx,
@@ -311,7 +311,7 @@ fn box_test(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
         let t0 = nx.max(ny.max(nz.max(ctx.t_min)));
         let inf = F32x4::splat(f32::INFINITY);
         let t1 = fx.min(fy.min(fz.min(inf)));
-        // Widen outward whatever the sign (rt_core::widen_far).
+        // Widen outward whatever the sign (rt_core::internal::widen_far).
         let t1 = t1.mul(ctx.far_up).max(t1.mul(ctx.far_down)).min(t_max);
         mask |= t0.le_mask(t1) << (4 * g);
         tnear[4 * g..4 * g + 4].copy_from_slice(&t0.to_array());
@@ -339,8 +339,8 @@ fn box_test(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
     let t0 = nx.max(ny.max(nz.max(F32x8::splat(ctx.ray.t_min))));
     let t1 = fx.min(fy.min(fz.min(F32x8::splat(f32::INFINITY))));
     let t1 = t1
-        .mul(F32x8::splat(rt_core::SLAB_FAR_SCALE))
-        .max(t1.mul(F32x8::splat(rt_core::SLAB_FAR_SCALE_NEG)))
+        .mul(F32x8::splat(rt_core::internal::SLAB_FAR_SCALE))
+        .max(t1.mul(F32x8::splat(rt_core::internal::SLAB_FAR_SCALE_NEG)))
         .min(F32x8::splat(t_max));
     (t0.le_mask(t1), t0.to_array())
 }

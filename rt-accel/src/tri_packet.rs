@@ -12,7 +12,8 @@
 use glam::Vec3;
 use rt_core::{
     Aabb, Hit, PrimKind, Ray,
-    intersect::{TriangleHit, intersect_triangle_t, triangle_admits_hit, triangle_hit},
+    internal::triangle_admits_hit,
+    intersect::{TriangleHit, intersect_triangle_t, triangle_hit},
 };
 
 use crate::{

@@ -106,9 +106,9 @@ proptest! {
         let copied = Bvh::<TriPacket>::from_bytes(&bytes).unwrap();
         prop_assert_eq!(&copied, &bvh);
         // Zero-copy view over an aligned copy of the bytes.
-        let mut aligned = vec![0u128; bytes.len().div_ceil(16)];
-        bytemuck::cast_slice_mut::<u128, u8>(&mut aligned)[..bytes.len()].copy_from_slice(&bytes);
-        let view = rt_accel::BvhRef::<TriPacket>::from_bytes(&bytemuck::cast_slice(&aligned)[..bytes.len()]).unwrap();
+        let aligned = bvh.to_aligned_bytes();
+        prop_assert_eq!(&*aligned, &bytes[..]);
+        let view = rt_accel::BvhRef::<TriPacket>::from_bytes(&aligned).unwrap();
         for r in &rays {
             prop_assert_eq!(copied.closest_hit(r), bvh.closest_hit(r));
             prop_assert_eq!(view.closest_hit(r), bvh.closest_hit(r));
@@ -171,30 +171,6 @@ fn bad_input_is_an_error_naming_it() {
         Err(BuildError::NonFiniteVertex { vertex: 2 })
     );
     assert_eq!(bvh, before, "a failed refit changes nothing");
-}
-
-/// A scalar that is linear in space, sampled at the vertices, interpolates
-/// at every hit to its exact value at the hit point (barycentrics are right
-/// and belong to the reported triangle).
-#[test]
-fn mesh_scalars_interpolate_at_hits() {
-    use rt_accel::TriangleMesh;
-    let (pos, idx) = icosphere(2);
-    let f = |p: Vec3| 2.0 * p.x - 0.5 * p.y + 3.0 * p.z + 1.0;
-    let scalars = pos.iter().map(|p| f(*p)).collect();
-    let mesh = TriangleMesh::new(pos.clone(), idx, Some(scalars)).unwrap();
-    let bvh = mesh.build_bvh(&params()).unwrap();
-    let mut hits = 0;
-    for i in 0..200 {
-        let a = i as f32 * 0.618;
-        let o = Vec3::new(3.0 * a.cos(), 1.3 * (0.7 * a).sin(), 3.0 * a.sin());
-        let h = bvh.closest_hit(&Ray::new(o, -o + Vec3::new(0.1, -0.2, 0.05))).expect("hit");
-        let s = mesh.interpolate_scalar(&h).unwrap();
-        assert!((s - f(h.position)).abs() < 1e-4, "{s} vs {}", f(h.position));
-        hits += 1;
-    }
-    assert_eq!(hits, 200);
-    assert!(TriangleMesh::new(pos, vec![[0, 1, 2]], Some(vec![0.0])).is_err());
 }
 
 /// Spheres and capsules moved (and resized) by a refit answer like brute

@@ -12,6 +12,10 @@
 //! there is one anywhere (the verdict is reduced over all ranks).
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
+// The seeded image generator the tests use.
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use std::{process::ExitCode, time::Duration};
 
 use rt_composite::{
@@ -20,40 +24,7 @@ use rt_composite::{
     serial_fold,
 };
 use rt_core::Pixel;
-
-/// A deterministic image: about `active` of the pixels drawn; few distinct
-/// depths so that ties between ranks are common; now and then a NaN
-/// colour, a `-0.0` colour or depth, an infinite or NaN depth.
-fn image(seed: u64, len: usize, active: f64) -> Vec<Pixel> {
-    let mut x = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
-    let mut next = move || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x
-    };
-    (0..len)
-        .map(|_| {
-            let r = next();
-            if (r % 1000) as f64 >= active * 1000.0 {
-                return Pixel::BACKGROUND;
-            }
-            let a = ((r >> 10) % 5) as f32 / 4.0;
-            let c = |k: u64| a * ((r >> (20 + 4 * k)) % 16) as f32 / 15.0;
-            let depth = match (r >> 40) % 23 {
-                0 => f32::INFINITY,
-                1 => f32::NAN,
-                2 => -0.0,
-                d => (d % 4) as f32,
-            };
-            let mut color = [c(0), c(1), c(2), a];
-            if (r >> 50) % 31 == 0 {
-                color[1] = f32::NAN;
-            }
-            Pixel { color, depth }
-        })
-        .collect()
-}
+use support::image;
 
 fn bits<F: Fragment>(p: &[F]) -> Vec<u8> {
     let mut out = vec![0; p.len() * F::SIZE];

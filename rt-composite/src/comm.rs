@@ -2,11 +2,11 @@
 //! (the calls IceT makes of MPI: rank, size, tagged point-to-point byte
 //! messages), and an in-process implementation on threads and channels.
 
-use alloc::{string::String, vec::Vec};
+use alloc::vec::Vec;
 use core::fmt;
 
 /// Why a message could not be sent or received.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CommError {
     /// A rank outside `0..size`.
     NoSuchRank(usize),
@@ -19,8 +19,19 @@ pub enum CommError {
         /// The awaited tag.
         tag: u32,
     },
-    /// The transport reported an error (e.g. MPI).
-    Transport(String),
+    /// A tag the transport cannot carry (`MpiComm`: above `i32::MAX`,
+    /// the largest MPI tag type).
+    TagTooLarge(u32),
+    /// A message longer than the transport can carry, in bytes
+    /// (`MpiComm`: above `i32::MAX`, the largest MPI count).
+    MessageTooLarge(usize),
+    /// The transport itself failed, with its own error code (for
+    /// communicators built on other libraries: an MPI error class, an
+    /// `errno`, …).
+    Transport {
+        /// The transport's error code.
+        code: i32,
+    },
 }
 
 impl fmt::Display for CommError {
@@ -31,7 +42,14 @@ impl fmt::Display for CommError {
             Self::Timeout { from, tag } => {
                 write!(f, "timed out waiting for rank {from} (tag {tag})")
             }
-            Self::Transport(m) => write!(f, "transport: {m}"),
+            Self::TagTooLarge(tag) => {
+                write!(f, "tag {tag} is too large for the transport (an MPI tag is an i32)")
+            }
+            Self::MessageTooLarge(n) => write!(
+                f,
+                "a {n}-byte message is too large for the transport (an MPI count is an i32)"
+            ),
+            Self::Transport { code } => write!(f, "the transport failed with error code {code}"),
         }
     }
 }
@@ -154,7 +172,7 @@ mod threads {
 
 #[cfg(feature = "mpi")]
 mod mpi_comm {
-    use alloc::{boxed::Box, format, vec::Vec};
+    use alloc::{boxed::Box, vec::Vec};
     use core::{cell::RefCell, time::Duration};
     use std::time::Instant;
 
@@ -247,8 +265,7 @@ mod mpi_comm {
     }
 
     fn tag_of(tag: u32) -> Result<Tag, CommError> {
-        Tag::try_from(tag)
-            .map_err(|_| CommError::Transport(format!("tag {tag} exceeds an MPI tag")))
+        Tag::try_from(tag).map_err(|_| CommError::TagTooLarge(tag))
     }
 
     impl Communicator for MpiComm {
@@ -264,10 +281,7 @@ mod mpi_comm {
             let peer = self.peer(to)?;
             let tag = tag_of(tag)?;
             if i32::try_from(data.len()).is_err() {
-                return Err(CommError::Transport(format!(
-                    "a {}-byte message exceeds an MPI count",
-                    data.len()
-                )));
+                return Err(CommError::MessageTooLarge(data.len()));
             }
             self.reap();
             let buffer = Box::into_raw(data.into_boxed_slice());

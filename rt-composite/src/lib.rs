@@ -70,5 +70,5 @@ pub use fragment::{Fragment, Pixel8, over, z_composite};
 /// callers initialise MPI with the same version.
 #[cfg(feature = "mpi")]
 pub use mpi;
-pub use schedule::{CompositeError, Mode, Schedule, Stats, composite, serial_fold};
+pub use schedule::{CompositeError, MessageProblem, Mode, Schedule, Stats, composite, serial_fold};
 pub use sparse::{DecodeError, SparseImage};

@@ -76,7 +76,7 @@ pub enum CompositeError {
         /// The sender.
         from: usize,
         /// What was wrong.
-        reason: &'static str,
+        problem: MessageProblem,
     },
     /// The transport failed.
     Comm(CommError),
@@ -99,7 +99,9 @@ impl fmt::Display for CompositeError {
             Self::SizeMismatch { rank, size } => {
                 write!(f, "rank {rank} composites a {}×{} image", size.0, size.1)
             }
-            Self::Malformed { from, reason } => write!(f, "bad message from rank {from}: {reason}"),
+            Self::Malformed { from, problem } => {
+                write!(f, "bad message from rank {from}: {problem}")
+            }
             Self::Comm(e) => write!(f, "{e}"),
             Self::FailedElsewhere => f.write_str("compositing failed on another rank"),
             Self::BadRadix(k) => write!(f, "radix-k needs k ≥ 2, got {k}"),
@@ -111,14 +113,40 @@ impl fmt::Display for CompositeError {
     }
 }
 
-impl core::error::Error for CompositeError {}
+impl core::error::Error for CompositeError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            Self::Comm(e) => Some(e),
+            Self::Malformed { problem: MessageProblem::Decode(e), .. } => Some(e),
+            _ => None,
+        }
+    }
+}
 
-fn reason(e: DecodeError) -> &'static str {
-    match e {
-        DecodeError::Truncated => "truncated sparse image",
-        DecodeError::TrailingBytes => "bytes after the sparse image",
-        DecodeError::Inconsistent => "sparse image runs do not add up",
-        DecodeError::StoredBackground => "sparse image stores a background pixel",
+/// What was wrong with a message another rank sent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MessageProblem {
+    /// Shorter than the message header, or without its magic number.
+    NoHeader,
+    /// A header flag this version does not know.
+    UnknownFlag(u8),
+    /// A sparse image of another pixel span than the schedule assigned.
+    UnexpectedSpan,
+    /// A gathered span that ends past the image.
+    SpanPastImage,
+    /// The sparse image does not decode.
+    Decode(DecodeError),
+}
+
+impl fmt::Display for MessageProblem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NoHeader => f.write_str("no rt-composite header"),
+            Self::UnknownFlag(v) => write!(f, "unknown flag {v}"),
+            Self::UnexpectedSpan => f.write_str("not the expected pixel span"),
+            Self::SpanPastImage => f.write_str("span past the image"),
+            Self::Decode(e) => write!(f, "{e}"),
+        }
     }
 }
 
@@ -282,9 +310,9 @@ impl<C: Communicator, F: Fragment> Run<'_, C, F> {
                 return None;
             }
         };
-        let malformed = |reason| CompositeError::Malformed { from, reason };
+        let malformed = |problem| CompositeError::Malformed { from, problem };
         if bytes.len() < HEADER || bytes[..4] != MAGIC.to_le_bytes() {
-            self.fail(malformed("no rt-composite header"));
+            self.fail(malformed(MessageProblem::NoHeader));
             return None;
         }
         let u = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
@@ -295,8 +323,8 @@ impl<C: Communicator, F: Fragment> Run<'_, C, F> {
                 return None;
             }
             0 => {}
-            _ => {
-                self.fail(malformed("unknown flag"));
+            flag => {
+                self.fail(malformed(MessageProblem::UnknownFlag(flag)));
                 return None;
             }
         }
@@ -307,11 +335,11 @@ impl<C: Communicator, F: Fragment> Run<'_, C, F> {
         match SparseImage::from_bytes(&bytes[HEADER..]) {
             Ok(img) if want.is_none_or(|w| img.range() == *w) => Some(img),
             Ok(_) => {
-                self.fail(malformed("not the expected pixel span"));
+                self.fail(malformed(MessageProblem::UnexpectedSpan));
                 None
             }
             Err(e) => {
-                self.fail(malformed(reason(e)));
+                self.fail(malformed(MessageProblem::Decode(e)));
                 None
             }
         }
@@ -448,7 +476,10 @@ pub fn composite<C: Communicator, F: Fragment>(
         for r in 1..n {
             if let Some(img) = run.recv(r, GATHER_TAG, None) {
                 if img.range().end > total {
-                    run.fail(CompositeError::Malformed { from: r, reason: "span past the image" });
+                    run.fail(CompositeError::Malformed {
+                        from: r,
+                        problem: MessageProblem::SpanPastImage,
+                    });
                 } else if run.error.is_none() {
                     img.write_into(&mut full);
                 }

@@ -3,31 +3,18 @@
 //! extreme alphas. Every schedule must give exactly the documented answer
 //! (not merely the serial fold's), on every rank count.
 
-use core::time::Duration;
+mod support;
 
-use rt_composite::{Fragment, Mode, Schedule, ThreadComm, composite};
+use rt_composite::{Fragment, Mode, Schedule};
 use rt_core::Pixel;
+use support::bits;
 
 const SCHEDULES: [Schedule; 4] =
     [Schedule::DirectSend, Schedule::BinarySwap, Schedule::RadixK(3), Schedule::RadixK(4)];
 
-fn bits(p: &[Pixel]) -> Vec<[u32; 5]> {
-    p.iter()
-        .map(|p| [p.color[0], p.color[1], p.color[2], p.color[3], p.depth].map(f32::to_bits))
-        .collect()
-}
-
 /// Rank 0's composited image for `images` (one per rank), `w × h`.
 fn run(images: &[Vec<Pixel>], w: u32, h: u32, s: Schedule, m: &Mode) -> Vec<Pixel> {
-    let comms = ThreadComm::group(images.len(), Duration::from_secs(20));
-    let out: Vec<_> = std::thread::scope(|sc| {
-        let hs: Vec<_> = comms
-            .into_iter()
-            .zip(images)
-            .map(|(c, img)| sc.spawn(move || composite(&c, img, w, h, s, m)))
-            .collect();
-        hs.into_iter().map(|h| h.join().expect("no panic")).collect()
-    });
+    let out = support::run(images, (w, h), s, m);
     let mut first = None;
     for (r, o) in out.into_iter().enumerate() {
         let (img, _) = o.unwrap_or_else(|e| panic!("rank {r} {s:?}: {e}"));

@@ -7,12 +7,12 @@
 mod capsule;
 mod offset;
 mod sphere;
-mod triangle;
+pub(crate) mod triangle;
 
 pub use capsule::{Capsule, intersect_capsule, intersect_capsule_t};
 pub use offset::{next_float_down, next_float_up, offset_ray_origin, spawn_ray, spawn_ray_to};
 pub use sphere::{Sphere, intersect_sphere, intersect_sphere_t, solve_quadratic};
 pub use triangle::{
     TriangleHit, WatertightRay, intersect_triangle, intersect_triangle_t, is_degenerate_triangle,
-    settle_triangle_t, triangle_admits_hit, triangle_hit,
+    triangle_hit,
 };

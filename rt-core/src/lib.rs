@@ -4,7 +4,8 @@
 //! rays, boxes, cameras, exact and robust ray–primitive intersection tests,
 //! frames of premultiplied colour plus depth, colour maps and seeded
 //! sampling. It knows nothing of acceleration structures: shading code is
-//! written against [`SceneQuery`], which `rt-accel` implements.
+//! written against [`SceneQuery`], which `rt-accel` implements; the
+//! renderer that uses it lives in `rt-surface`.
 //!
 //! ## Conventions
 //! - Right-handed coordinates; angles in radians.
@@ -18,9 +19,8 @@
 //! | feature | default | what it does |
 //! |---|---|---|
 //! | `std` | yes | float functions from std; implies `alloc` |
-//! | `alloc` | via `std` | [`Frame`] (owned pixel storage), the [`render`]er |
+//! | `alloc` | via `std` | [`Frame`] (owned pixel storage) |
 //! | `libm` | no | float functions from `libm` for `no_std` builds |
-//! | `parallel` | no | [`Renderer`] renders tiles on rayon (implies `std`) |
 //!
 //! Everything else (intersections, cameras, colour maps, sampling) needs
 //! neither std nor an allocator.
@@ -51,11 +51,9 @@ mod hit;
 pub mod intersect;
 mod math;
 mod ray;
-#[cfg(feature = "alloc")]
-pub mod render;
 pub mod sampling;
 
-pub use aabb::{Aabb, SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG, widen_far};
+pub use aabb::Aabb;
 pub use camera::{Camera, CameraError, Projection};
 pub use colormap::{ColorMap, ColorMapError, ColorStop};
 #[cfg(feature = "alloc")]
@@ -64,9 +62,21 @@ pub use hit::{Hit, PrimKind, SceneQuery};
 pub use intersect::{offset_ray_origin, spawn_ray, spawn_ray_to};
 pub use math::gamma;
 pub use ray::Ray;
-#[cfg(feature = "alloc")]
-pub use render::{
-    Light, Material, RayCounts, RenderError, Renderer, Settings, ShadeScene, Surface,
-};
 
 pub use glam;
+
+/// What `rt-accel`'s SIMD kernels share with the scalar tests here, so that
+/// both round the same way and a BVH answers bit for bit like a brute-force
+/// loop. Not part of the documented API: it may change in any release.
+#[doc(hidden)]
+pub mod internal {
+    pub use crate::{
+        aabb::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG, widen_far},
+        intersect::triangle::{settle_triangle_t, triangle_admits_hit},
+    };
+}
+
+/// The crate README's example, compiled and run as a doc test.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

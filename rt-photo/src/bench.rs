@@ -11,7 +11,7 @@ use rt_volume::{
     TraceResult, trace, trace_beam, trace_visiting,
 };
 
-use crate::{Cutoff, Film};
+use crate::{Cutoff, CutoffError, Film, Photon, math};
 
 /// What the film records.
 #[derive(Clone, Debug, PartialEq)]
@@ -41,24 +41,86 @@ pub enum Weighting {
 }
 
 /// Why a render could not run.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BenchError {
-    /// A parameter is out of range (named).
-    BadParameter(&'static str),
-    /// Tracing a photon failed.
+    /// The beam's `center`, `direction` or `u` has a NaN or infinite
+    /// component.
+    BeamNotFinite,
+    /// `direction` and `u` are not unit vectors at right angles (to 1e-9).
+    NotOrthonormal,
+    /// The beam's `width` or `height` is not finite and positive.
+    BeamSize {
+        /// The beam's width.
+        width: f64,
+        /// The beam's height.
+        height: f64,
+    },
+    /// `film_distance` is NaN or infinite.
+    FilmDistance(f64),
+    /// `strata` is outside `1..=64`.
+    Strata(u32),
+    /// The schlieren cutoff is invalid ([`Cutoff::validate`]).
+    Cutoff(CutoffError),
+    /// The interferometer's wavelength is not finite and positive.
+    Wavelength(f64),
+    /// The interferometer's reference index is not finite and positive.
+    ReferenceIndex(f64),
+    /// The interferometer's fringe spacing is not finite and positive.
+    FringeSpacing(f64),
+    /// Tracing a photon failed (or building the beam mask of
+    /// [`Bench::render_grid`]).
     Trace(TraceError),
 }
 
 impl fmt::Display for BenchError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::BadParameter(p) => write!(f, "bad parameter: {p}"),
+            Self::BeamNotFinite => write!(f, "beam centre, direction or u is not finite"),
+            Self::NotOrthonormal => {
+                write!(f, "beam direction and u must be orthonormal (unit length, at right angles)")
+            }
+            Self::BeamSize { width, height } => write!(
+                f,
+                "beam width and height must be finite and positive (got {width} × {height})"
+            ),
+            Self::FilmDistance(l) => write!(f, "film distance must be finite (got {l})"),
+            Self::Strata(k) => {
+                write!(f, "strata must be in 1..=64 (photons per pixel = strata²), got {k}")
+            }
+            Self::Cutoff(e) => write!(f, "bad cutoff: {e}"),
+            Self::Wavelength(l) => write!(f, "wavelength must be finite and positive (got {l})"),
+            Self::ReferenceIndex(n) => {
+                write!(f, "reference index must be finite and positive (got {n})")
+            }
+            Self::FringeSpacing(s) => {
+                write!(f, "fringe spacing must be finite and positive (got {s})")
+            }
             Self::Trace(e) => write!(f, "trace: {e}"),
         }
     }
 }
 
-impl core::error::Error for BenchError {}
+impl core::error::Error for BenchError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            Self::Cutoff(e) => Some(e),
+            Self::Trace(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl From<CutoffError> for BenchError {
+    fn from(e: CutoffError) -> Self {
+        Self::Cutoff(e)
+    }
+}
+
+impl From<TraceError> for BenchError {
+    fn from(e: TraceError) -> Self {
+        Self::Trace(e)
+    }
+}
 
 /// A collimated beam, the optics behind the test section, and the film.
 #[derive(Clone, Debug, PartialEq)]
@@ -86,51 +148,43 @@ pub struct Bench {
     pub params: TraceParams,
 }
 
-/// One traced photon: film coordinates (pixels), weight, deflection.
-type Landing = crate::Photon;
-
 impl Bench {
     fn v(&self) -> DVec3 {
         self.direction.cross(self.u)
     }
 
-    fn validate(&self, film: &Film) -> Result<(), BenchError> {
-        let bad = BenchError::BadParameter;
+    /// Checks the parameters. (A [`Film`] is never empty: `Film::new`
+    /// refuses zero sizes.)
+    fn validate(&self) -> Result<(), BenchError> {
         let finite3 = |v: DVec3| v.is_finite();
         if !(finite3(self.center) && finite3(self.direction) && finite3(self.u)) {
-            return Err(bad("beam centre/direction/u not finite"));
+            return Err(BenchError::BeamNotFinite);
         }
         if (self.direction.length() - 1.0).abs() > 1e-9
             || (self.u.length() - 1.0).abs() > 1e-9
             || self.u.dot(self.direction).abs() > 1e-9
         {
-            return Err(bad("direction and u must be orthonormal"));
+            return Err(BenchError::NotOrthonormal);
         }
-        if !(self.width.is_finite()
-            && self.width > 0.0
-            && self.height.is_finite()
-            && self.height > 0.0)
-        {
-            return Err(bad("beam width/height"));
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        if !(positive(self.width) && positive(self.height)) {
+            return Err(BenchError::BeamSize { width: self.width, height: self.height });
         }
         if !(self.film_distance.is_finite()) {
-            return Err(bad("film distance"));
+            return Err(BenchError::FilmDistance(self.film_distance));
         }
-        if self.strata == 0 || self.strata > 64 {
-            return Err(bad("strata must be 1..=64 (photons per pixel = strata²)"));
-        }
-        if film.width() == 0 || film.height() == 0 {
-            return Err(bad("film is empty"));
+        if !(1..=64).contains(&self.strata) {
+            return Err(BenchError::Strata(self.strata));
         }
         match &self.mode {
-            Mode::Schlieren(c) => c.validate().map_err(bad),
+            Mode::Schlieren(c) => c.validate().map_err(BenchError::Cutoff),
             Mode::Interferometry { lambda, n_ref, fringe_spacing } => {
-                if !(lambda.is_finite() && *lambda > 0.0) {
-                    Err(bad("wavelength must be finite and > 0"))
-                } else if !(n_ref.is_finite() && *n_ref > 0.0) {
-                    Err(bad("reference index"))
-                } else if fringe_spacing.is_some_and(|s| !(s.is_finite() && s > 0.0)) {
-                    Err(bad("fringe spacing"))
+                if !positive(*lambda) {
+                    Err(BenchError::Wavelength(*lambda))
+                } else if !positive(*n_ref) {
+                    Err(BenchError::ReferenceIndex(*n_ref))
+                } else if let Some(s) = fringe_spacing.filter(|&s| !positive(s)) {
+                    Err(BenchError::FringeSpacing(s))
                 } else {
                     Ok(())
                 }
@@ -146,7 +200,7 @@ impl Bench {
         row: usize,
         pass: u64,
         seed: u64,
-    ) -> Result<Vec<Landing>, BenchError> {
+    ) -> Result<Vec<Photon>, BenchError> {
         let (w, h) = (film.width(), film.height());
         let k = self.strata as usize;
         let mut rng = rng_for(seed ^ pass.wrapping_mul(0x9e37_79b9_7f4a_7c15), row as u64);
@@ -192,11 +246,11 @@ impl Bench {
                             core::f64::consts::TAU / lambda * (r.optical_path - n_ref * straight);
                         let carrier =
                             fringe_spacing.map_or(0.0, |s| core::f64::consts::TAU * fa / s);
-                        [(0.5 * (1.0 + (phi + carrier).cos())) as f32; 3]
+                        [(0.5 * (1.0 + math::cos(phi + carrier))) as f32; 3]
                     }
                 };
                 let weight = [weight[0] * colour[0], weight[1] * colour[1], weight[2] * colour[2]];
-                out.push((fx, fy, weight, (eu, ev)));
+                out.push(Photon::new(fx, fy, weight, (eu, ev)));
             }
         }
         Ok(out)
@@ -266,7 +320,7 @@ impl Bench {
         if field.interp() != Interp::Trilinear {
             return self.render(field, film, pass, seed);
         }
-        self.validate(film)?;
+        self.validate()?;
         let window = BeamWindow {
             center: self.center,
             direction: self.direction,
@@ -335,17 +389,17 @@ impl Bench {
         pass: u64,
         seed: u64,
     ) -> Result<(), BenchError> {
-        self.validate(film)?;
+        self.validate()?;
         let rows: Vec<usize> = (0..film.height()).collect();
         #[cfg(feature = "parallel")]
-        let traced: Vec<Result<Vec<Landing>, BenchError>> = {
+        let traced: Vec<Result<Vec<Photon>, BenchError>> = {
             use rayon::prelude::*;
             rows.par_iter().map(|&r| self.row(tracer, film, r, pass, seed)).collect()
         };
         #[cfg(not(feature = "parallel"))]
-        let traced: Vec<Result<Vec<Landing>, BenchError>> =
+        let traced: Vec<Result<Vec<Photon>, BenchError>> =
             rows.iter().map(|&r| self.row(tracer, film, r, pass, seed)).collect();
-        let traced: Vec<Vec<Landing>> = traced.into_iter().collect::<Result<_, _>>()?;
+        let traced: Vec<Vec<Photon>> = traced.into_iter().collect::<Result<_, _>>()?;
         film.emitted += traced.iter().map(|r| r.len() as u64).sum::<u64>();
         film.splat_all(traced.iter().flatten());
         film.per_pixel += f64::from(self.strata * self.strata);

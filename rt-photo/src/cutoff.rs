@@ -2,6 +2,9 @@
 //! image plane): what fraction of it reaches the film, per colour channel.
 
 use alloc::vec::Vec;
+use core::fmt;
+
+use crate::math;
 
 /// A 2-D RGB filter image indexed by deflection (rainbow schlieren, or a
 /// filter painted by the user).
@@ -32,9 +35,9 @@ impl FilterImage {
         for j in 0..size {
             for i in 0..size {
                 let (u, v) = (f.coord(i), f.coord(j));
-                let r = (u * u + v * v).sqrt() / half_range;
-                let a = v.atan2(u);
-                let c = |shift: f64| (0.5 + 0.5 * (a - shift).cos()) as f32;
+                let r = math::sqrt(u * u + v * v) / half_range;
+                let a = math::atan2(v, u);
+                let c = |shift: f64| (0.5 + 0.5 * math::cos(a - shift)) as f32;
                 let k = r.min(1.0) as f32;
                 f.rgb[i + size * j] =
                     [(1.0 - k) + k * c(0.0), (1.0 - k) + k * c(2.094), (1.0 - k) + k * c(4.189)];
@@ -64,7 +67,7 @@ impl FilterImage {
     /// image: opaque).
     #[must_use]
     pub fn at(&self, eu: f64, ev: f64) -> [f32; 3] {
-        let to = |e: f64| ((e / self.half_range + 1.0) * 0.5 * self.size as f64).floor();
+        let to = |e: f64| math::floor((e / self.half_range + 1.0) * 0.5 * self.size as f64);
         let (i, j) = (to(eu), to(ev));
         if i >= 0.0 && j >= 0.0 && (i as usize) < self.size && (j as usize) < self.size {
             self.rgb[i as usize + self.size * j as usize]
@@ -73,6 +76,113 @@ impl FilterImage {
         }
     }
 }
+
+/// A parameter of a [`Cutoff`], as a [`CutoffError`] names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CutoffParam {
+    /// `angle`: the direction a knife edge or graded filter is sensitive
+    /// to.
+    Angle,
+    /// `offset`: the shift of a knife edge.
+    Offset,
+    /// `f`: the focal length of the schlieren head.
+    FocalLength,
+    /// `h`: the height of the source image (knife edge).
+    SourceHeight,
+    /// `width`: the width of a graded filter's ramp.
+    Width,
+    /// `radius`: the radius of a pinhole or dark-field stop.
+    Radius,
+    /// `half_range`: the deflection at a colour filter image's edges.
+    HalfRange,
+}
+
+impl CutoffParam {
+    /// The field's name in [`Cutoff`] or [`FilterImage`].
+    #[must_use]
+    pub const fn field(self) -> &'static str {
+        match self {
+            Self::Angle => "angle",
+            Self::Offset => "offset",
+            Self::FocalLength => "f",
+            Self::SourceHeight => "h",
+            Self::Width => "width",
+            Self::Radius => "radius",
+            Self::HalfRange => "half_range",
+        }
+    }
+}
+
+impl fmt::Display for CutoffParam {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let what = match self {
+            Self::Angle => "angle",
+            Self::Offset => "offset",
+            Self::FocalLength => "focal length",
+            Self::SourceHeight => "source image height",
+            Self::Width => "ramp width",
+            Self::Radius => "stop radius",
+            Self::HalfRange => "filter image half range",
+        };
+        write!(f, "{what} `{}`", self.field())
+    }
+}
+
+/// Why [`Cutoff::validate`] refused a cutoff.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CutoffError {
+    /// An angle or offset is NaN or infinite.
+    NotFinite {
+        /// Which one.
+        param: CutoffParam,
+        /// Its value.
+        value: f64,
+    },
+    /// A length (focal length, source height, ramp width, stop radius) or
+    /// a colour filter's half range is not finite and positive.
+    NotPositive {
+        /// Which one.
+        param: CutoffParam,
+        /// Its value.
+        value: f64,
+    },
+    /// The colour filter image has no pixels (`size` is 0).
+    EmptyImage,
+    /// The colour filter image's `rgb` does not hold `size²` pixels.
+    ImageSize {
+        /// Its `size`.
+        size: usize,
+        /// The length of its `rgb`.
+        len: usize,
+    },
+    /// The colour filter image holds a NaN or infinite transmission.
+    NonFiniteImage {
+        /// Index of the first such pixel in `rgb`.
+        pixel: usize,
+    },
+}
+
+impl fmt::Display for CutoffError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NotFinite { param, value } => {
+                write!(f, "cutoff {param} must be finite (got {value})")
+            }
+            Self::NotPositive { param, value } => {
+                write!(f, "cutoff {param} must be finite and positive (got {value})")
+            }
+            Self::EmptyImage => write!(f, "colour filter image has no pixels (size 0)"),
+            Self::ImageSize { size, len } => {
+                write!(f, "colour filter image of size {size} needs {size}² pixels, has {len}")
+            }
+            Self::NonFiniteImage { pixel } => {
+                write!(f, "colour filter image pixel {pixel} is not finite")
+            }
+        }
+    }
+}
+
+impl core::error::Error for CutoffError {}
 
 /// The cutoff in the schlieren head's focal plane.
 #[derive(Clone, Debug, PartialEq)]
@@ -118,44 +228,52 @@ pub enum Cutoff {
 }
 
 impl Cutoff {
-    /// Checks the parameters.
+    /// Checks the parameters: angles and offsets finite, lengths finite
+    /// and positive, a colour filter image of `size²` finite pixels.
     ///
     /// # Errors
-    /// A message naming the bad parameter.
-    pub fn validate(&self) -> Result<(), &'static str> {
-        let pos = |v: f64| v.is_finite() && v > 0.0;
+    /// The first bad parameter, in the order the variant's fields are
+    /// declared, as a [`CutoffError`].
+    pub fn validate(&self) -> Result<(), CutoffError> {
+        use CutoffParam as P;
+        let finite = |param, value: f64| {
+            if value.is_finite() { Ok(()) } else { Err(CutoffError::NotFinite { param, value }) }
+        };
+        let positive = |param, value: f64| {
+            if value.is_finite() && value > 0.0 {
+                Ok(())
+            } else {
+                Err(CutoffError::NotPositive { param, value })
+            }
+        };
         match self {
             Self::None => Ok(()),
             Self::KnifeEdge { angle, offset, f, h } => {
-                if !(angle.is_finite() && offset.is_finite()) {
-                    Err("knife edge angle/offset not finite")
-                } else if !(pos(*f) && pos(*h)) {
-                    Err("knife edge f and h must be finite and positive")
-                } else {
-                    Ok(())
-                }
+                finite(P::Angle, *angle)?;
+                finite(P::Offset, *offset)?;
+                positive(P::FocalLength, *f)?;
+                positive(P::SourceHeight, *h)
             }
             Self::Graded { angle, f, width } => {
-                if angle.is_finite() && pos(*f) && pos(*width) {
-                    Ok(())
-                } else {
-                    Err("graded filter parameters")
-                }
+                finite(P::Angle, *angle)?;
+                positive(P::FocalLength, *f)?;
+                positive(P::Width, *width)
             }
             Self::Pinhole { f, radius, .. } => {
-                if pos(*f) && pos(*radius) {
-                    Ok(())
-                } else {
-                    Err("pinhole f and radius must be positive")
-                }
+                positive(P::FocalLength, *f)?;
+                positive(P::Radius, *radius)
             }
             Self::Color(img) => {
-                if img.size == 0 || img.rgb.len() != img.size * img.size || !pos(img.half_range) {
-                    Err("colour filter image is empty or malformed")
-                } else if img.rgb.iter().flatten().any(|v| !v.is_finite()) {
-                    Err("colour filter image has non-finite values")
-                } else {
-                    Ok(())
+                if img.size == 0 {
+                    return Err(CutoffError::EmptyImage);
+                }
+                if img.size.checked_mul(img.size) != Some(img.rgb.len()) {
+                    return Err(CutoffError::ImageSize { size: img.size, len: img.rgb.len() });
+                }
+                positive(P::HalfRange, img.half_range)?;
+                match img.rgb.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
+                    Some(pixel) => Err(CutoffError::NonFiniteImage { pixel }),
+                    None => Ok(()),
                 }
             }
         }
@@ -190,7 +308,7 @@ impl Cutoff {
             Self::KnifeEdge { angle, .. } | Self::Graded { angle, .. } => *angle,
             _ => 0.0,
         };
-        Prepared { cutoff: self, cos: angle.cos(), sin: angle.sin() }
+        Prepared { cutoff: self, cos: math::cos(angle), sin: math::sin(angle) }
     }
 }
 
@@ -215,7 +333,7 @@ impl Prepared<'_> {
             Cutoff::KnifeEdge { offset, f, h, .. } => gray(0.5 + f / h * along + offset),
             Cutoff::Graded { f, width, .. } => gray(0.5 + f * along / width),
             Cutoff::Pinhole { f, radius, dark_field } => {
-                let r = f * (eu * eu + ev * ev).sqrt();
+                let r = f * math::sqrt(eu * eu + ev * ev);
                 let inside = r <= *radius;
                 // NaN is neither inside nor outside: blocked either way.
                 gray(if r.is_nan() || inside == *dark_field { 0.0 } else { 1.0 })
@@ -254,14 +372,46 @@ mod tests {
         assert_eq!(rotated.transmit(0.0, 2.5e-4)[0], 0.75);
         let p = Cutoff::Pinhole { f: 1.0, radius: 1e-3, dark_field: true };
         assert_eq!((p.transmit(0.0, 0.0)[0], p.transmit(2e-3, 0.0)[0]), (0.0, 1.0));
-        assert!(
-            Cutoff::KnifeEdge { angle: f64::NAN, offset: 0.0, f: 1.0, h: 1.0 }.validate().is_err()
+        assert!(matches!(
+            Cutoff::KnifeEdge { angle: f64::NAN, offset: 0.0, f: 1.0, h: 1.0 }.validate(),
+            Err(CutoffError::NotFinite { param: CutoffParam::Angle, value }) if value.is_nan()
+        ));
+        assert_eq!(
+            Cutoff::Color(FilterImage { size: 0, rgb: alloc::vec![], half_range: 1.0 }).validate(),
+            Err(CutoffError::EmptyImage)
         );
-        assert!(
-            Cutoff::Color(FilterImage { size: 0, rgb: alloc::vec![], half_range: 1.0 })
-                .validate()
-                .is_err()
+    }
+
+    /// Each bad parameter is named, first bad one first.
+    #[test]
+    fn validate_names_the_bad_parameter() {
+        use CutoffParam as P;
+        let not_pos = |param, value| Err(CutoffError::NotPositive { param, value });
+        let knife = |angle, offset, f, h| Cutoff::KnifeEdge { angle, offset, f, h };
+        assert_eq!(knife(0.0, 0.0, 1.0, 1.0).validate(), Ok(()));
+        assert_eq!(
+            knife(0.0, f64::INFINITY, -1.0, 1.0).validate(),
+            Err(CutoffError::NotFinite { param: P::Offset, value: f64::INFINITY })
         );
+        assert_eq!(knife(0.0, 0.0, 1.0, 0.0).validate(), not_pos(P::SourceHeight, 0.0));
+        let graded = Cutoff::Graded { angle: 0.0, f: f64::INFINITY, width: 1.0 };
+        assert_eq!(graded.validate(), not_pos(P::FocalLength, f64::INFINITY));
+        let graded = Cutoff::Graded { angle: 0.0, f: 1.0, width: -1.0 };
+        assert_eq!(graded.validate(), not_pos(P::Width, -1.0));
+        let pin = Cutoff::Pinhole { f: 1.0, radius: 0.0, dark_field: false };
+        assert_eq!(pin.validate(), not_pos(P::Radius, 0.0));
+        let img = |size, n, half_range| {
+            Cutoff::Color(FilterImage { size, rgb: alloc::vec![[0.5; 3]; n], half_range })
+        };
+        assert_eq!(img(2, 3, 1.0).validate(), Err(CutoffError::ImageSize { size: 2, len: 3 }));
+        assert_eq!(img(2, 4, 0.0).validate(), not_pos(P::HalfRange, 0.0));
+        assert_eq!(img(2, 4, 1.0).validate(), Ok(()));
+        let mut bad = FilterImage::opaque(2, 1.0);
+        bad.rgb[3][1] = f32::NAN;
+        assert_eq!(Cutoff::Color(bad).validate(), Err(CutoffError::NonFiniteImage { pixel: 3 }));
+        // Messages name the parameter for command-line users.
+        let shown = alloc::format!("{}", knife(0.0, 0.0, -2.0, 1.0).validate().unwrap_err());
+        assert_eq!(shown, "cutoff focal length `f` must be finite and positive (got -2)");
     }
 
     #[test]

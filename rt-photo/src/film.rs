@@ -1,6 +1,9 @@
 //! The film: photons splatted with a normalised reconstruction filter.
 
 use alloc::vec::Vec;
+use core::fmt;
+
+use crate::math;
 
 /// The reconstruction filter.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -10,8 +13,8 @@ pub enum Filter {
     Box,
     /// Bilinear tent of one pixel radius; weights sum to 1 per photon.
     Tent,
-    /// A wider tent, `radius` pixels (≥ 1), weights normalised per photon:
-    /// for few photons per pixel (see [`Filter::adaptive`]).
+    /// A wider tent, `radius` pixels (finite, ≥ 1), weights normalised
+    /// per photon: for few photons per pixel (see [`Filter::adaptive`]).
     WideTent {
         /// Radius in pixels.
         radius: f64,
@@ -24,14 +27,84 @@ impl Filter {
     /// than one pixel.
     #[must_use]
     pub fn adaptive(photons_per_pixel: f64) -> Self {
-        let r = if photons_per_pixel > 0.0 { (4.0 / photons_per_pixel).sqrt() } else { 4.0 };
+        let r = if photons_per_pixel > 0.0 { math::sqrt(4.0 / photons_per_pixel) } else { 4.0 };
         if r <= 1.0 { Self::Tent } else { Self::WideTent { radius: r.min(16.0) } }
     }
 }
 
-/// A photon landed on the film: pixel coordinates `(x, y)`, RGB weight,
-/// deflection `(εu, εv)`.
-pub type Photon = (f64, f64, [f32; 3], (f64, f64));
+/// A photon landed on the film, as [`Film::splat_all`] takes them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Photon {
+    /// Film coordinate in pixels, continuous, growing to the right: pixel
+    /// `(i, j)` spans `[i, i+1) × [j, j+1)`.
+    pub x: f64,
+    /// Film coordinate in pixels, continuous, growing downward (row 0 is
+    /// the top of the image).
+    pub y: f64,
+    /// Weight per linear RGB channel: the cutoff's transmission (times
+    /// the colour a multifield render carries); 1 is one undisturbed,
+    /// uncut photon.
+    pub weight: [f32; 3],
+    /// Deflection `(εu, εv)` in radians along the image axes u (to the
+    /// right) and v (up, against `y`): the photon's unit exit direction
+    /// projected on them, i.e. the sines of the deflection angles, equal to
+    /// the angles for small deflections. Averaged per pixel by
+    /// [`Film::mean_deflection`].
+    pub deflection: (f64, f64),
+}
+
+impl Photon {
+    /// A photon at `(x, y)` (pixels) with RGB `weight` and `deflection`
+    /// `(εu, εv)` (radians).
+    #[inline]
+    #[must_use]
+    pub const fn new(x: f64, y: f64, weight: [f32; 3], deflection: (f64, f64)) -> Self {
+        Self { x, y, weight, deflection }
+    }
+}
+
+/// Why a film could not be made.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FilmError {
+    /// The width or the height is zero.
+    ZeroSize {
+        /// Requested width in pixels.
+        width: usize,
+        /// Requested height in pixels.
+        height: usize,
+    },
+    /// More than [`Film::MAX_PIXELS`] pixels (or `width × height`
+    /// overflows).
+    TooLarge {
+        /// Requested width in pixels.
+        width: usize,
+        /// Requested height in pixels.
+        height: usize,
+    },
+    /// A [`Filter::WideTent`] radius that is NaN, infinite or below one
+    /// pixel.
+    BadFilterRadius(f64),
+}
+
+impl fmt::Display for FilmError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::ZeroSize { width, height } => {
+                write!(f, "a {width}×{height} film has no pixels")
+            }
+            Self::TooLarge { width, height } => write!(
+                f,
+                "a {width}×{height} film exceeds the limit of {} pixels",
+                Film::MAX_PIXELS
+            ),
+            Self::BadFilterRadius(r) => {
+                write!(f, "wide tent filter radius {r} must be finite and at least 1 pixel")
+            }
+        }
+    }
+}
+
+impl core::error::Error for FilmError {}
 
 /// Accumulated photon weight per pixel (RGB), the mean deflection per pixel
 /// (the picking pass), and photon bookkeeping.
@@ -51,15 +124,30 @@ pub struct Film {
 }
 
 impl Film {
+    /// The most pixels a film may have: 2²⁸ (its accumulators take 48
+    /// bytes a pixel, 12 GiB at the limit).
+    pub const MAX_PIXELS: usize = 1 << 28;
+
     /// An empty film of `width × height` pixels.
     ///
     /// # Errors
-    /// A message for zero or too large sizes.
-    pub fn new(width: usize, height: usize, filter: Filter) -> Result<Self, &'static str> {
+    /// [`FilmError::ZeroSize`] if `width` or `height` is 0,
+    /// [`FilmError::TooLarge`] beyond [`Film::MAX_PIXELS`],
+    /// [`FilmError::BadFilterRadius`] for a [`Filter::WideTent`] radius
+    /// that is not finite and ≥ 1.
+    pub fn new(width: usize, height: usize, filter: Filter) -> Result<Self, FilmError> {
+        if width == 0 || height == 0 {
+            return Err(FilmError::ZeroSize { width, height });
+        }
         let n = width
             .checked_mul(height)
-            .filter(|&n| n > 0 && n <= 1 << 28)
-            .ok_or("film size is zero or too large")?;
+            .filter(|&n| n <= Self::MAX_PIXELS)
+            .ok_or(FilmError::TooLarge { width, height })?;
+        if let Filter::WideTent { radius } = filter
+            && !(radius.is_finite() && radius >= 1.0)
+        {
+            return Err(FilmError::BadFilterRadius(radius));
+        }
         Ok(Self {
             width,
             height,
@@ -103,8 +191,8 @@ impl Film {
         x >= 0.0 && y >= 0.0 && x < self.width as f64 && y < self.height as f64
     }
 
-    /// Splats photons `(x, y, weight, deflection)` in order: the same image,
-    /// bit for bit, as calling [`Film::splat`] on each in turn. With feature
+    /// Splats photons in order: the same image, bit for bit, as calling
+    /// [`Film::splat`] on each in turn. With feature
     /// `parallel` the film's rows are split into bands filled in parallel,
     /// each band taking, in order, the photons whose footprint reaches it,
     /// so every pixel still sums its contributions in the serial order.
@@ -116,7 +204,7 @@ impl Film {
         {
             use rayon::prelude::*;
             let (width, height, filter) = (self.width, self.height, self.filter);
-            let lost = photons.clone().filter(|p| !self.on_film(p.0, p.1)).count();
+            let lost = photons.clone().filter(|p| !self.on_film(p.x, p.y)).count();
             // Rows a photon's footprint may reach beyond its own.
             let reach = match filter {
                 Filter::Box => 0.0,
@@ -131,7 +219,7 @@ impl Film {
                 .enumerate()
                 .for_each(|(b, (rgb, eps_acc))| {
                     let (lo, hi) = (b * rows, (b * rows + rgb.len() / width));
-                    for &(x, y, w, e) in photons.clone() {
+                    for &Photon { x, y, weight: w, deflection: e } in photons.clone() {
                         let on = x >= 0.0 && y >= 0.0 && x < width as f64 && y < height as f64;
                         if !on || y + reach < lo as f64 || y - reach >= hi as f64 {
                             continue;
@@ -147,8 +235,8 @@ impl Film {
             self.lost += lost as u64;
         }
         #[cfg(not(feature = "parallel"))]
-        for &(x, y, w, e) in photons {
-            self.splat(x, y, w, e);
+        for p in photons {
+            self.splat(p.x, p.y, p.weight, p.deflection);
         }
     }
 
@@ -159,11 +247,26 @@ impl Film {
     }
 
     /// The image normalised to the background: 1 where nothing deflects
-    /// and nothing is cut, per channel, row-major.
+    /// and nothing is cut, per channel, row-major; all 0 before any photon
+    /// was emitted. Rounded to `f32` (a relative step of 6e-8): see
+    /// [`Film::normalized_f64`] to measure smaller differences.
     #[must_use]
     pub fn normalized(&self) -> Vec<[f32; 3]> {
+        self.normalized_iter().map(|p| p.map(|c| c as f32)).collect()
+    }
+
+    /// [`Film::normalized`] in the `f64` the film accumulates in, for
+    /// measurements of differences too small for `f32`: between two
+    /// renders, or between pixels of a weak signal (a relative 1e-9 is
+    /// lost in `f32`, kept here).
+    #[must_use]
+    pub fn normalized_f64(&self) -> Vec<[f64; 3]> {
+        self.normalized_iter().collect()
+    }
+
+    fn normalized_iter(&self) -> impl Iterator<Item = [f64; 3]> + '_ {
         let k = if self.per_pixel > 0.0 { 1.0 / self.per_pixel } else { 0.0 };
-        self.rgb.iter().map(|p| [(p[0] * k) as f32, (p[1] * k) as f32, (p[2] * k) as f32]).collect()
+        self.rgb.iter().map(move |p| [p[0] * k, p[1] * k, p[2] * k])
     }
 
     /// Mean deflection `(εu, εv)` of the photons that landed in each pixel
@@ -202,8 +305,10 @@ fn footprint(
             // Separable tent over the pixel centres within `radius`;
             // normalised over the pixels on the film.
             let r = radius.max(1.0);
-            let (i0, i1) = (((x - r - 0.5).ceil()).max(0.0), ((x + r - 0.5).floor()).min(wd - 1.0));
-            let (j0, j1) = (((y - r - 0.5).ceil()).max(0.0), ((y + r - 0.5).floor()).min(ht - 1.0));
+            let (i0, i1) =
+                (math::ceil(x - r - 0.5).max(0.0), math::floor(x + r - 0.5).min(wd - 1.0));
+            let (j0, j1) =
+                (math::ceil(y - r - 0.5).max(0.0), math::floor(y + r - 0.5).min(ht - 1.0));
             let tent = |d: f64| (1.0 - d.abs() / r).max(0.0);
             let mut total = 0.0;
             let mut j = j0;
@@ -237,7 +342,7 @@ fn footprint(
             // falling off the film are renormalised onto the rest, so
             // every photon deposits exactly 1.
             let (u, v) = (x - 0.5, y - 0.5);
-            let (i0, j0) = (u.floor(), v.floor());
+            let (i0, j0) = (math::floor(u), math::floor(v));
             let (fx, fy) = (u - i0, v - j0);
             let mut cells = [(0usize, 0usize, 0.0f64); 4];
             let mut total = 0.0;
@@ -256,5 +361,44 @@ fn footprint(
                 add(i, j, k / total);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two pixels 1e-9 apart (relative): `f32` rounds them to the same
+    /// value, `f64` keeps the difference.
+    #[test]
+    fn normalized_f64_keeps_what_f32_loses() {
+        let mut film = Film::new(2, 1, Filter::Box).unwrap();
+        film.splat(0.5, 0.5, [1.0; 3], (0.0, 0.0));
+        film.splat(1.5, 0.5, [1.0; 3], (0.0, 0.0));
+        film.splat(1.5, 0.5, [1e-9; 3], (0.0, 0.0));
+        film.per_pixel = 1.0;
+        let (narrow, wide) = (film.normalized(), film.normalized_f64());
+        assert_eq!(narrow[0], narrow[1], "f32 cannot tell them apart");
+        let d = wide[1][0] - wide[0][0];
+        assert!((d - 1e-9).abs() < 1e-15, "f64 keeps the difference: {d:e}");
+        for (a, b) in narrow.iter().flatten().zip(wide.iter().flatten()) {
+            assert_eq!(*a, *b as f32, "normalized is normalized_f64 rounded");
+        }
+    }
+
+    #[test]
+    fn bad_sizes_and_radii_are_typed_errors() {
+        let e = |w, h, f| Film::new(w, h, f).unwrap_err();
+        assert_eq!(e(0, 8, Filter::Box), FilmError::ZeroSize { width: 0, height: 8 });
+        assert_eq!(e(8, 0, Filter::Tent), FilmError::ZeroSize { width: 8, height: 0 });
+        let huge = FilmError::TooLarge { width: 1 << 20, height: 1 << 20 };
+        assert_eq!(e(1 << 20, 1 << 20, Filter::Box), huge);
+        let over = FilmError::TooLarge { width: usize::MAX, height: 2 };
+        assert_eq!(e(usize::MAX, 2, Filter::Box), over);
+        for r in [f64::NAN, f64::INFINITY, 0.5, -2.0] {
+            let got = e(4, 4, Filter::WideTent { radius: r });
+            assert!(matches!(got, FilmError::BadFilterRadius(x) if x.to_bits() == r.to_bits()));
+        }
+        assert!(Film::new(4, 4, Filter::WideTent { radius: 1.0 }).is_ok());
     }
 }

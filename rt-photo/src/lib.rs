@@ -11,24 +11,78 @@
 //! deterministic: the same seed gives the same image, bit for bit, at any
 //! thread count (feature `parallel`).
 //!
+//! The `rt-volume` types this crate's API takes are re-exported at the
+//! root ([`IndexField`], [`GridField`], [`Octree`], [`TraceParams`], …),
+//! the whole of [`rt_volume`] (analytic fields, grids, readers) beside
+//! them, and [`glam`] for `DVec3`: one dependency is enough.
+//!
 //! ## Features
 //! | feature | default | what it does |
 //! |---|---|---|
-//! | `std` | yes | float functions (required for now) |
-//! | `parallel` | no | rows rendered with rayon |
+//! | `std` | yes | float functions from std (here, in `rt-volume` and `rt-core`) |
+//! | `libm` | no | float functions from `libm` for `no_std` builds |
+//! | `parallel` | no | rows traced and films splatted with rayon (implies `std`); images stay bit-identical |
+//!
+//! Without `std`, one of `std` or `libm` must be on; an allocator is always
+//! needed (films and photon rows live on `alloc`).
+//!
+//! ## Example
+//! A knife-edge schlieren image of a weak Gaussian bump of index: light
+//! bends toward the higher index at the centre, so with the edge across
+//! the u axis the left side brightens and the right side darkens.
+//! ```
+//! use rt_photo::glam::DVec3;
+//! use rt_photo::rt_volume::GaussianBump;
+//! use rt_photo::{Bench, Cutoff, Film, Filter, Mode, TraceParams, Weighting};
+//!
+//! // n = 1 + 1e-4·exp(−r²/2), σ = 1, cut off beyond r = 5.
+//! let field = GaussianBump::new(DVec3::ZERO, 1e-4, 1.0, 5.0);
+//! let bench = Bench {
+//!     center: DVec3::new(0.0, 0.0, -6.0), // the beam starts upstream
+//!     direction: DVec3::Z,
+//!     u: DVec3::X,
+//!     width: 6.0,
+//!     height: 6.0,
+//!     film_distance: 0.0, // image the test section (no shadowgraph)
+//!     // f/h = 1500: a deflection of 1/3000 rad changes the image by 0.5.
+//!     mode: Mode::Schlieren(Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.5, h: 1e-3 }),
+//!     weighting: Weighting::Weight,
+//!     strata: 4, // 4 × 4 photons per pixel
+//!     params: TraceParams::accurate(),
+//! };
+//! let mut film = Film::new(16, 16, Filter::Tent)?;
+//! bench.render(&field, &mut film, 0, 42)?;
+//! let image = film.normalized(); // 0.5 = undisturbed, half cut
+//! // Row 8 (through the centre): brighter left of it, darker right of it.
+//! let row = &image[16 * 8..16 * 9];
+//! let left = row[..8].iter().map(|p| p[0]).sum::<f32>() / 8.0;
+//! let right = row[8..].iter().map(|p| p[0]).sum::<f32>() / 8.0;
+//! assert!(left > 0.55 && right < 0.45, "{left} {right}");
+//! # Ok::<(), Box<dyn core::error::Error>>(())
+//! ```
 #![no_std]
 
 extern crate alloc;
 #[cfg(feature = "std")]
 extern crate std;
 
-#[cfg(not(feature = "std"))]
-compile_error!("rt-photo needs feature `std` for its float functions.");
-
 mod bench;
 mod cutoff;
 mod film;
+mod math;
 
 pub use bench::{Bench, BenchError, Mode, Weighting};
-pub use cutoff::{Cutoff, FilterImage};
-pub use film::{Film, Filter, Photon};
+pub use cutoff::{Cutoff, CutoffError, CutoffParam, FilterImage};
+pub use film::{Film, FilmError, Filter, Photon};
+// The types in this crate's signatures, from the crates below it (and
+// `build_octree`, the only way to the `Octree` that `render_grid` takes).
+pub use rt_core::ColorMap;
+pub use rt_volume::{
+    GridField, IndexField, Octree, TraceError, TraceParams, TraceResult, build_octree,
+};
+
+/// The whole of `rt-volume`: analytic and gridded fields, integrators,
+/// octree skipping, readers (feature `io` of `rt-volume`).
+pub use rt_volume;
+/// The `glam` of `rt-volume` and `rt-core` (`DVec3` for beams).
+pub use rt_volume::glam;

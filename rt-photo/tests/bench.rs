@@ -1,31 +1,17 @@
 //! The optical bench against exact answers (ORACLES §5), conservation and
 //! determinism.
 
+mod support;
+
 use glam::DVec3;
-use rt_photo::{Bench, Cutoff, Film, Filter, Mode, Weighting};
+use rt_photo::{
+    Bench, BenchError, Cutoff, CutoffError, CutoffParam, Film, FilmError, Filter, Mode, Photon,
+    Weighting,
+};
 use rt_volume::{Bounds, Constant, GaussianBump, TraceParams};
+use support::{bench, knife};
 
 const SQRT_2PI: f64 = 2.506_628_274_631_000_5;
-
-/// A beam along +z over `[-3, 3]²`, emitted at z = −6.
-fn bench(mode: Mode, strata: u32) -> Bench {
-    Bench {
-        center: DVec3::new(0.0, 0.0, -6.0),
-        direction: DVec3::Z,
-        u: DVec3::X,
-        width: 6.0,
-        height: 6.0,
-        film_distance: 0.0,
-        mode,
-        weighting: Weighting::Weight,
-        strata,
-        params: TraceParams::accurate(),
-    }
-}
-
-fn knife(f_over_h: f64) -> Mode {
-    Mode::Schlieren(Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: f_over_h * 1e-3, h: 1e-3 })
-}
 
 /// Pixel centre `(x, y)` in scene units.
 fn centre(film: &Film, i: usize, j: usize) -> (f64, f64) {
@@ -171,29 +157,57 @@ fn bad_parameters_are_errors() {
     let f = GaussianBump::new(DVec3::ZERO, 1e-4, 1.0, 5.0);
     let mut film = Film::new(8, 8, Filter::Box).unwrap();
     let before = film.clone();
-    let cases = [
-        bench(
-            Mode::Schlieren(Cutoff::KnifeEdge { angle: f64::NAN, offset: 0.0, f: 1.0, h: 1.0 }),
-            2,
+    type IsExpected = fn(BenchError) -> bool;
+    let cases: [(Bench, IsExpected); 6] = [
+        (
+            bench(
+                Mode::Schlieren(Cutoff::KnifeEdge { angle: f64::NAN, offset: 0.0, f: 1.0, h: 1.0 }),
+                2,
+            ),
+            |e| {
+                matches!(
+                    e,
+                    BenchError::Cutoff(CutoffError::NotFinite { param: CutoffParam::Angle, .. })
+                )
+            },
         ),
-        bench(Mode::Interferometry { lambda: 0.0, n_ref: 1.0, fringe_spacing: None }, 2),
-        bench(Mode::Interferometry { lambda: -1.0, n_ref: 1.0, fringe_spacing: Some(1.0) }, 2),
-        bench(
-            Mode::Schlieren(Cutoff::Color(rt_photo::FilterImage {
-                size: 0,
-                rgb: vec![],
-                half_range: 1.0,
-            })),
-            2,
+        (bench(Mode::Interferometry { lambda: 0.0, n_ref: 1.0, fringe_spacing: None }, 2), |e| {
+            e == BenchError::Wavelength(0.0)
+        }),
+        (
+            bench(Mode::Interferometry { lambda: -1.0, n_ref: 1.0, fringe_spacing: Some(1.0) }, 2),
+            |e| e == BenchError::Wavelength(-1.0),
         ),
-        bench(Mode::Schlieren(Cutoff::None), 0),
-        Bench { direction: DVec3::new(0.0, 0.0, 2.0), ..bench(Mode::Schlieren(Cutoff::None), 2) },
+        (
+            bench(
+                Mode::Schlieren(Cutoff::Color(rt_photo::FilterImage {
+                    size: 0,
+                    rgb: vec![],
+                    half_range: 1.0,
+                })),
+                2,
+            ),
+            |e| e == BenchError::Cutoff(CutoffError::EmptyImage),
+        ),
+        (bench(Mode::Schlieren(Cutoff::None), 0), |e| e == BenchError::Strata(0)),
+        (
+            Bench {
+                direction: DVec3::new(0.0, 0.0, 2.0),
+                ..bench(Mode::Schlieren(Cutoff::None), 2)
+            },
+            |e| e == BenchError::NotOrthonormal,
+        ),
     ];
-    for b in cases {
-        assert!(b.render(&f, &mut film, 0, 1).is_err());
+    for (b, expected) in cases {
+        let e = b.render(&f, &mut film, 0, 1).unwrap_err();
+        assert!(expected(e), "{e:?}");
         assert_eq!(film, before);
     }
-    assert!(Film::new(0, 8, Filter::Box).is_err());
+    // The wrapped cause is the error's source.
+    let e = BenchError::from(CutoffError::EmptyImage);
+    let source = core::error::Error::source(&e).map(ToString::to_string);
+    assert_eq!(source, Some(CutoffError::EmptyImage.to_string()));
+    assert_eq!(Film::new(0, 8, Filter::Box), Err(FilmError::ZeroSize { width: 0, height: 8 }));
 }
 
 /// Linearised shadowgraph of a weak bump at small `L`:
@@ -386,17 +400,17 @@ fn parallel_splat_equals_serial_splat() {
         state ^= state << 17;
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
-    let photons: Vec<rt_photo::Photon> = (0..20_000)
+    let photons: Vec<Photon> = (0..20_000)
         .map(|_| {
             let (x, y) = (next() * 44.0 - 2.0, next() * 34.0 - 2.0);
             let w = [next() as f32, next() as f32, 1.0];
-            (x, y, w, (next() - 0.5, next() - 0.5))
+            Photon::new(x, y, w, (next() - 0.5, next() - 0.5))
         })
         .collect();
     for filter in [Filter::Box, Filter::Tent, Filter::WideTent { radius: 2.5 }] {
         let mut serial = Film::new(40, 30, filter).unwrap();
-        for &(x, y, w, e) in &photons {
-            serial.splat(x, y, w, e);
+        for p in &photons {
+            serial.splat(p.x, p.y, p.weight, p.deflection);
         }
         for threads in [1, 2, 7] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();

@@ -4,9 +4,11 @@
 //! narrower than the beam's sampling. Each test asserts conservation,
 //! range or linearity — the property that matters — not just "no panic".
 
+mod support;
+
 use glam::DVec3;
-use rt_photo::{Bench, Cutoff, Film, Filter, Mode, Weighting};
-use rt_volume::{GaussianBump, TraceParams};
+use rt_photo::{Bench, Cutoff, Film, Filter, Mode};
+use rt_volume::GaussianBump;
 
 fn filters() -> [Filter; 4] {
     [Filter::Box, Filter::Tent, Filter::WideTent { radius: 2.5 }, Filter::adaptive(0.1)]
@@ -94,25 +96,10 @@ fn cutoffs_over_twenty_decades_of_deflection() {
     }
 }
 
-/// A beam along +z through `[-3, 3]²` with a knife edge.
+/// A beam along +z through `[-3, 3]²` with a knife edge, one photon per
+/// pixel.
 fn knife_bench(f_over_h: f64) -> Bench {
-    Bench {
-        center: DVec3::new(0.0, 0.0, -6.0),
-        direction: DVec3::Z,
-        u: DVec3::X,
-        width: 6.0,
-        height: 6.0,
-        film_distance: 0.0,
-        mode: Mode::Schlieren(Cutoff::KnifeEdge {
-            angle: 0.0,
-            offset: 0.0,
-            f: f_over_h * 1e-3,
-            h: 1e-3,
-        }),
-        weighting: Weighting::Weight,
-        strata: 1,
-        params: TraceParams::accurate(),
-    }
+    support::bench(support::knife(f_over_h), 1)
 }
 
 /// The knife-edge signal of a Gaussian bump for strength `delta` and

@@ -7,7 +7,8 @@
 //! - [`IndexField`]: `n(x)` and `∇n(x)` in one call, constant outside its
 //!   [`Bounds`]. Analytic fields for every closed-form case in the
 //!   project's oracles ([`LinearIndex`], [`LinearSquared`], [`GrinRod`],
-//!   [`Luneburg`], [`GaussianBump`]) and [`FnField`] for closures.
+//!   [`Luneburg`], [`GaussianBump`]), [`FnField`] for a closure giving `n`
+//!   and `∇n`, [`FnIndex`] for one giving `n` alone (central differences).
 //! - [`trace`]: straight to the bounds, integrated inside them with
 //!   [`Method::Euler`] (baseline), [`Method::Rk4`], [`Method::Adaptive`]
 //!   (Dormand–Prince 5(4)) or [`Method::Symplectic`] (leapfrog), landed
@@ -58,7 +59,7 @@ pub mod skip;
 mod trace;
 
 pub use analytic::{
-    Constant, FnField, GaussianBump, GrinRod, LinearIndex, LinearSquared, Luneburg,
+    Constant, FnField, FnIndex, GaussianBump, GrinRod, LinearIndex, LinearSquared, Luneburg,
 };
 pub use field::{Bounds, IndexField};
 #[cfg(feature = "alloc")]
@@ -74,3 +75,8 @@ pub use trace::{
 };
 
 pub use glam;
+
+/// The crate README's example, compiled and run as a doc test.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

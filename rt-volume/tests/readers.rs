@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
-use rt_volume::io::{ReadError, parse_nrrd, read_grid};
+use rt_volume::io::{ReadError, ReadErrorKind, parse_nrrd, read_grid};
 
 /// The repository's copy of the project's real CFD data (the main job
 /// embeds it): raw payload, JSON sidecar and a detached NRRD header.
@@ -14,9 +14,9 @@ fn data(name: &str) -> PathBuf {
 }
 
 /// The blast wave through every form: detached NRRD header, the same header
-/// with the payload attached (as the original `.nrrd` file has it), and raw
-/// + JSON: same geometry and samples, the statistics its provenance records
-/// (min, max, mean).
+/// with the payload attached (as the original `.nrrd` file has it), and the
+/// raw payload with its JSON sidecar: same geometry and samples, the
+/// statistics its provenance records (min, max, mean).
 #[test]
 fn blast_wave_reads_identically_from_nrrd_and_raw_json() {
     let a = read_grid(&data("blast_sedov_64.nhdr")).expect("detached nrrd");
@@ -40,6 +40,11 @@ fn blast_wave_reads_identically_from_nrrd_and_raw_json() {
     assert!((mean - 1.0).abs() < 1e-6, "mass conserved: mean {mean}");
 }
 
+/// What went wrong, for a result that must be an error.
+fn kind<T: core::fmt::Debug>(r: Result<T, ReadError>) -> ReadErrorKind {
+    r.unwrap_err().into_kind()
+}
+
 fn header(body: &str) -> Vec<u8> {
     let mut v = format!("NRRD0004\n{body}\n\n").into_bytes();
     v.extend([0u8; 8 * 4]);
@@ -53,7 +58,7 @@ fn malformed_nrrd_is_an_error() {
     assert!(parse_nrrd(&header(ok), None).is_ok());
     for bytes in [&b"P6 not nrrd"[..], b"NRRD0004\ntype: float"] {
         let e = parse_nrrd(bytes, None).unwrap_err();
-        assert!(matches!(e, ReadError::Malformed(_)), "{e}");
+        assert!(matches!(e.kind(), ReadErrorKind::Malformed { .. }), "{e}");
     }
     for (body, want) in [
         ("type: float\ndimension: 2\nsizes: 2 2\nencoding: raw", "dimension"),
@@ -71,33 +76,58 @@ fn malformed_nrrd_is_an_error() {
     let mut short = header(ok);
     short.truncate(short.len() - 3);
     assert!(matches!(
-        parse_nrrd(&short, None),
-        Err(ReadError::Truncated { expected: 32, found: 29 })
+        kind(parse_nrrd(&short, None)),
+        ReadErrorKind::Truncated { expected: 32, found: 29 }
     ));
     let huge =
         header("type: float\ndimension: 3\nsizes: 4294967296 4294967296 4294967296\nencoding: raw");
-    assert!(matches!(parse_nrrd(&huge, None), Err(ReadError::Grid(_))));
+    assert!(matches!(kind(parse_nrrd(&huge, None)), ReadErrorKind::TooLarge));
     // NaN samples.
     let mut nan = header(ok);
     let n = nan.len();
     nan[n - 4..].copy_from_slice(&f32::NAN.to_le_bytes());
     assert!(matches!(
-        parse_nrrd(&nan, None),
-        Err(ReadError::Grid(rt_volume::GridError::NonFinite { index: 7 }))
+        kind(parse_nrrd(&nan, None)),
+        ReadErrorKind::Grid(rt_volume::GridError::NonFinite { index: 7 })
     ));
     // Zero spacing.
     let zero = header("type: float\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nspacings: 1 0 1");
     assert!(matches!(
-        parse_nrrd(&zero, None),
-        Err(ReadError::Grid(rt_volume::GridError::BadGeometry))
+        kind(parse_nrrd(&zero, None)),
+        ReadErrorKind::Grid(rt_volume::GridError::BadGeometry)
     ));
 }
 
 /// Missing files and bad JSON headers are errors too.
 #[test]
 fn missing_files_and_bad_json_are_errors() {
-    assert!(matches!(read_grid(Path::new("/nonexistent/x.nrrd")), Err(ReadError::Io { .. })));
-    assert!(matches!(read_grid(Path::new("x.vtu")), Err(ReadError::Unsupported(_))));
+    let missing = Path::new("/nonexistent/x.nrrd");
+    let e = read_grid(missing).unwrap_err();
+    assert!(matches!(e.kind(), ReadErrorKind::Io(io) if io.kind() == std::io::ErrorKind::NotFound));
+    assert_eq!(e.path(), Some(missing));
+    assert!(e.to_string().starts_with("/nonexistent/x.nrrd: "), "{e}");
+    assert!(core::error::Error::source(&e).is_some(), "the I/O error is the source");
+    let e = read_grid(Path::new("x.vtu")).unwrap_err();
+    assert!(matches!(e.kind(), ReadErrorKind::UnknownFormat));
+    assert!(e.to_string().starts_with("x.vtu: unknown grid format"), "{e}");
+    // A detached NRRD header whose payload file is missing names that file.
+    let dir = std::env::temp_dir().join(format!("rt-volume-detached-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let nhdr = dir.join("h.nhdr");
+    std::fs::write(
+        &nhdr,
+        "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: gone.raw\n\n",
+    )
+    .unwrap();
+    let e = read_grid(&nhdr).unwrap_err();
+    assert!(matches!(e.kind(), ReadErrorKind::Io(_)), "{e:?}");
+    assert_eq!(e.path(), Some(dir.join("gone.raw").as_path()));
+    // A bad header names the header file.
+    std::fs::write(&nhdr, "NRRD0004\ntype: float\n").unwrap();
+    let e = read_grid(&nhdr).unwrap_err();
+    assert_eq!(e.path(), Some(nhdr.as_path()));
+    assert!(e.to_string().starts_with(&format!("{}: malformed header", nhdr.display())), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
     let v: serde_json::Value =
         serde_json::json!({"dims": [2, 2], "spacing": [1, 1, 1], "origin": [0, 0, 0]});
     assert!(rt_volume::io::parse_raw_json(&v, &[0; 32]).is_err());
@@ -105,11 +135,14 @@ fn missing_files_and_bad_json_are_errors() {
         serde_json::json!({"dims": [2, 2, 2], "spacing": [1, 1, 1], "origin": [0, 0, 0]});
     assert!(rt_volume::io::parse_raw_json(&v, &[0; 32]).is_ok());
     assert!(matches!(
-        rt_volume::io::parse_raw_json(&v, &[0; 31]),
-        Err(ReadError::Truncated { .. })
+        kind(rt_volume::io::parse_raw_json(&v, &[0; 31])),
+        ReadErrorKind::Truncated { .. }
     ));
     let v: serde_json::Value = serde_json::json!({"dims": [2, 2, 2], "dtype": "complex64", "spacing": [1, 1, 1], "origin": [0, 0, 0]});
-    assert!(matches!(rt_volume::io::parse_raw_json(&v, &[0; 32]), Err(ReadError::Unsupported(_))));
+    assert!(matches!(
+        kind(rt_volume::io::parse_raw_json(&v, &[0; 32])),
+        ReadErrorKind::Unsupported(_)
+    ));
 }
 
 /// Legacy VTK structured points: geometry and samples as written; other data
@@ -139,14 +172,14 @@ fn vtk_structured_points() {
         "# vtk DataFile Version 3.0\nx\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3\n",
     )
     .unwrap();
-    assert!(matches!(read_grid(&bad), Err(ReadError::Malformed(_))), "{:?}", read_grid(&bad));
+    assert!(matches!(kind(read_grid(&bad)), ReadErrorKind::Malformed { .. }));
     let poly = dir.join("poly.vtk");
     std::fs::write(
         &poly,
         "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 1 float\n0 0 0\n",
     )
     .unwrap();
-    assert!(matches!(read_grid(&poly), Err(ReadError::Unsupported(_))), "{:?}", read_grid(&poly));
+    assert!(matches!(kind(read_grid(&poly)), ReadErrorKind::Unsupported(_)));
     let nan = dir.join("nan.vtk");
     let mut v = values.clone();
     v[5] = "nan".into();

@@ -128,7 +128,7 @@ fn run() -> Result<(), String> {
         params: TraceParams::fixed(Method::Rk4, field.grid().spacing().min_element()),
     };
     let height = ((size as f64) * bench.height / bench.width).round().max(1.0) as usize;
-    let mut film = Film::new(size, height, Filter::Tent).map_err(str::to_string)?;
+    let mut film = Film::new(size, height, Filter::Tent).map_err(|e| e.to_string())?;
     for pass in 0..passes.max(1) {
         bench.render(&field, &mut film, pass, 1).map_err(|e| e.to_string())?;
         let done = (pass + 1) as usize * 30 / passes.max(1) as usize;

@@ -1,7 +1,9 @@
 //! A `no_std` user of the rt crates: loads a BVH from bytes and traces a
-//! ray through it (no allocator needed), bends a ray through a linear
-//! index, and z-composites two encoded sparse images (on `alloc`, served
-//! by a bump allocator over a static arena).
+//! ray through it (no allocator needed), renders a frame of it through its
+//! own `ShadeScene` with shadows and ambient occlusion, bends a ray through a linear
+//! index, renders a tiny knife-edge schlieren image and splats a photon
+//! through a cutoff onto a film, and z-composites two encoded sparse
+//! images (on `alloc`, served by a bump allocator over a static arena).
 #![no_std]
 
 extern crate alloc;
@@ -22,7 +24,7 @@ fn panic(_: &PanicInfo<'_>) -> ! {
 }
 
 /// A bump allocator over 1 MiB that never frees: enough to show that
-/// rt-composite needs only `alloc`.
+/// rt-photo and rt-composite need only `alloc`.
 struct Bump {
     arena: UnsafeCell<[u8; 1 << 20]>,
     next: AtomicUsize,
@@ -89,6 +91,59 @@ pub fn trace(bytes: &[u8], origin: [f32; 3], direction: [f32; 3]) -> f32 {
     }
 }
 
+/// A user's scene for the surface renderer: a loaded BVH, one grey matte
+/// material, the geometric normal.
+struct Shaded<'a>(BvhRef<'a, TriPacket>);
+
+impl rt_core::SceneQuery for Shaded<'_> {
+    fn closest_hit(&self, ray: &Ray) -> Option<rt_core::Hit> {
+        self.0.closest_hit(ray)
+    }
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.0.occluded(ray)
+    }
+}
+
+impl rt_surface::ShadeScene for Shaded<'_> {
+    fn surface(&self, hit: &rt_core::Hit) -> rt_surface::Surface {
+        rt_surface::Surface {
+            albedo: [0.8; 3],
+            normal: hit.normal,
+            material: rt_surface::Material::MATTE,
+        }
+    }
+    fn bounds(&self) -> rt_core::Aabb {
+        self.0.bounds()
+    }
+}
+
+/// Mean red of a 4×4 frame of the serialized BVH `bytes` seen from `eye`
+/// (looking at the origin) under an ambient light with 4 AO rays and a
+/// shadowing directional light; -1 on an error.
+#[must_use]
+pub fn shade(bytes: &[u8], eye: [f32; 3]) -> f32 {
+    use rt_core::{Camera, Projection};
+    use rt_surface::{Light, Renderer, Settings};
+    let Ok(bvh) = BvhRef::<TriPacket>::from_bytes(bytes) else { return -1.0 };
+    let projection = Projection::Perspective { fov_y: 0.8 };
+    let Ok(camera) = Camera::look_at(Vec3::from(eye), Vec3::ZERO, Vec3::Y, projection, 4, 4)
+    else {
+        return -1.0;
+    };
+    let settings = Settings {
+        lights: alloc::vec![
+            Light::Ambient { color: [0.3; 3] },
+            Light::Directional { direction: Vec3::ONE, color: [0.7; 3] },
+        ],
+        ao_samples: 4,
+        ..Settings::default()
+    };
+    let Ok(mut renderer) = Renderer::new(camera, settings) else { return -1.0 };
+    renderer.render_pass(&Shaded(bvh));
+    let Ok(frame) = renderer.frame() else { return -1.0 };
+    frame.pixels().iter().map(|p| p.color[0]).sum::<f32>() / 16.0
+}
+
 /// Height at which a ray launched along +x at the origin leaves the unit
 /// box through a linear index `n = 1 + g·y` (a catenary), or NaN on error.
 #[must_use]
@@ -102,6 +157,43 @@ pub fn bend(g: f64) -> f64 {
     };
     rt_volume::trace(&f, v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), &TraceParams::accurate())
         .map_or(f64::NAN, |r| r.position.y)
+}
+
+/// Brightness of the left half of a 4×4 knife-edge schlieren image of a
+/// Gaussian bump of strength `delta` (0.5 undisturbed; more for
+/// `delta > 0`), plus the weight a photon deflected by `eps` (radians)
+/// leaves on a film through the same edge; NaN on an error.
+#[must_use]
+pub fn schlieren(delta: f64, eps: f64) -> f64 {
+    use rt_photo::glam::DVec3;
+    use rt_photo::rt_volume::GaussianBump;
+    use rt_photo::{Bench, Cutoff, Film, Filter, Mode, TraceParams, Weighting};
+    let edge = Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.0, h: 1e-3 };
+    if edge.validate().is_err() {
+        return f64::NAN;
+    }
+    let bench = Bench {
+        center: DVec3::new(0.0, 0.0, -6.0),
+        direction: DVec3::Z,
+        u: DVec3::X,
+        width: 6.0,
+        height: 6.0,
+        film_distance: 0.0,
+        mode: Mode::Schlieren(edge.clone()),
+        weighting: Weighting::Weight,
+        strata: 1,
+        params: TraceParams::accurate(),
+    };
+    let field = GaussianBump::new(DVec3::ZERO, delta, 1.0, 5.0);
+    let Ok(mut film) = Film::new(4, 4, Filter::Tent) else { return f64::NAN };
+    if bench.render(&field, &mut film, 0, 1).is_err() {
+        return f64::NAN;
+    }
+    let image = film.normalized_f64();
+    let left = image.iter().enumerate().filter(|(i, _)| i % 4 < 2).map(|(_, p)| p[0]).sum::<f64>();
+    let Ok(mut one) = Film::new(1, 1, Filter::Box) else { return f64::NAN };
+    one.splat(0.5, 0.5, edge.transmit(eps, 0.0), (eps, 0.0));
+    left / 8.0 + one.total()[0]
 }
 
 /// C entry point so the static library exports something.

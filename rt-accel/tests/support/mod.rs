@@ -87,27 +87,3 @@ pub fn params() -> BuildParams {
 pub type TriBvh = Bvh<TriPacket>;
 pub type SphereBvh = Bvh<SphereItem>;
 pub type CapsuleBvh = Bvh<CapsuleItem>;
-
-/// A cache-line aligned copy of `bytes` (zero-copy loading needs 64-byte
-/// alignment).
-pub fn aligned_copy(bytes: &[u8]) -> AlignedBytes {
-    let mut lines = vec![Line([0; 64]); bytes.len().div_ceil(64)];
-    bytemuck::cast_slice_mut::<Line, u8>(&mut lines)[..bytes.len()].copy_from_slice(bytes);
-    AlignedBytes { lines, len: bytes.len() }
-}
-
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-#[repr(C, align(64))]
-pub struct Line([u8; 64]);
-
-/// Bytes in 64-byte aligned storage.
-pub struct AlignedBytes {
-    lines: Vec<Line>,
-    len: usize,
-}
-
-impl AlignedBytes {
-    pub fn as_bytes(&self) -> &[u8] {
-        &bytemuck::cast_slice(&self.lines)[..self.len]
-    }
-}

@@ -10,7 +10,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::{Aabb, Hit, PrimKind, Ray, math::gamma, widen_far};
+use crate::{Aabb, Hit, PrimKind, Ray, aabb::widen_far, math::gamma};
 
 /// Per-ray constants of the watertight test: the dominant axis `kz`, the
 /// two others `kx`, `ky` (swapped to keep winding), and the shear.

@@ -145,7 +145,8 @@ impl Octree {
                             d[2] = d[2].max((at(i + di, j + dj, k + 1) - v).abs());
                         }
                     }
-                    let g = (0..3).map(|a| (f64::from(d[a]) / spacing[a]).powi(2)).sum::<f64>();
+                    let g =
+                        (0..3).map(|a| f64::from(d[a]) / spacing[a]).map(|q| q * q).sum::<f64>();
                     let node =
                         OctNode { min: lo, max: hi, grad_max: (sqrt(g) * (1.0 + 1e-6)) as f32 };
                     let b = (i / BRICK) + side * ((j / BRICK) + side * (k / BRICK));

@@ -6,7 +6,7 @@
 //!
 //! Writes, 8-bit sRGB PNGs:
 //! - `surface.png`: a ray-traced scientific surface scene rendered with
-//!   `rt_core::Renderer`: a terrain mesh coloured by its height through
+//!   `rt_surface::Renderer`: a terrain mesh coloured by its height through
 //!   viridis (the scalar is interpolated across each triangle, then
 //!   mapped), slightly mirroring sphere glyphs coloured with the
 //!   cool-to-warm map, and a glossy streamline tube, under ambient light
@@ -29,10 +29,10 @@ mod schlieren;
 use std::{path::PathBuf, process::ExitCode, time::Instant};
 
 use glam::Vec3;
-use rt_accel::{BuildParams, Glyphs, Paint, SurfaceScene, TriangleMesh, Tube};
-use rt_benches::{image::write_png, ply::write_ply, scenes};
-use rt_core::{
-    Camera, ColorMap, Light, Material, Projection, Renderer, Settings, intersect::Sphere,
+use rt_benches::{image::write_png, scenes};
+use rt_core::{Camera, ColorMap, Projection, intersect::Sphere};
+use rt_surface::{
+    Glyphs, Light, Material, Mesh, Paint, Renderer, Settings, SurfaceScene, Tube, io::write_ply,
 };
 
 const WIDTH: u32 = 960;
@@ -41,13 +41,13 @@ const HEIGHT: u32 = 640;
 const PASSES: u32 = 4;
 
 /// The terrain coloured by its height.
-fn terrain() -> Result<TriangleMesh, String> {
+fn terrain() -> Result<Mesh, String> {
     let terrain = scenes::terrain(257);
     let heights: Vec<f32> = terrain.positions.iter().map(|p| p.y).collect();
-    TriangleMesh::new(terrain.positions, terrain.indices, Some(heights)).map_err(|e| e.to_string())
+    Mesh::new(terrain.positions, terrain.indices, Some(heights)).map_err(|e| e.to_string())
 }
 
-fn build_world(mesh: TriangleMesh) -> Result<SurfaceScene<'static>, String> {
+fn build_world(mesh: Mesh) -> Result<SurfaceScene<'static>, String> {
     let heights = mesh.scalars().unwrap_or_default();
     let (lo, hi) = heights.iter().fold((f32::MAX, f32::MIN), |(a, b), &h| (a.min(h), b.max(h)));
     // A ring of glyphs above the terrain, sized and coloured by a scalar.
@@ -83,13 +83,12 @@ fn build_world(mesh: TriangleMesh) -> Result<SurfaceScene<'static>, String> {
         material: Material { mirror: 0.25, ..Material::GLOSSY },
     };
     let height = Paint::Mapped(ColorMap::viridis().with_range(lo, hi).map_err(|e| e.to_string())?);
-    SurfaceScene::build(
-        vec![(mesh, height, Material::MATTE)],
-        vec![glyphs],
-        vec![tube],
-        &BuildParams::medium(),
-    )
-    .map_err(|e| e.to_string())
+    SurfaceScene::builder()
+        .mesh(mesh, height, Material::MATTE)
+        .glyphs(glyphs)
+        .tube(tube)
+        .build()
+        .map_err(|e| e.to_string())
 }
 
 fn main() -> ExitCode {
@@ -107,7 +106,10 @@ fn run(out: &std::path::Path) -> Result<(), String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let mesh = terrain()?;
     // The terrain as a file, to try the `view` example on.
-    write_ply(&mesh, "height", &out.join("terrain.ply"))?;
+    let ply = out.join("terrain.ply");
+    let file = std::fs::File::create(&ply).map_err(|e| format!("{}: {e}", ply.display()))?;
+    write_ply(&mesh, "height", std::io::BufWriter::new(file))
+        .map_err(|e| format!("{}: {e}", ply.display()))?;
     let t0 = Instant::now();
     let world = build_world(mesh)?;
     let built = t0.elapsed();

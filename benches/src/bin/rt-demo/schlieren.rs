@@ -88,7 +88,7 @@ pub(crate) fn render_all(out: &Path) -> Result<(), String> {
     ];
     for (name, bench, scale) in jobs {
         let t = Instant::now();
-        let mut film = Film::new(SIZE, SIZE, Filter::Tent).map_err(str::to_string)?;
+        let mut film = Film::new(SIZE, SIZE, Filter::Tent).map_err(|e| e.to_string())?;
         bench.render(&f, &mut film, 0, 2026).map_err(|e| e.to_string())?;
         let path = out.join(name);
         write(&film, scale, &path)?;

@@ -8,14 +8,13 @@
 use std::{fmt::Write as _, hint::black_box, path::Path};
 
 use glam::{Vec2, Vec3};
-use rt_accel::{BuildParams, Paint, SurfaceScene, TriangleMesh};
+use rt_accel::BuildParams;
 use rt_benches::{
     plot::{PALETTE, Series, loglog},
     scenes,
 };
-use rt_core::{
-    Camera, ColorMap, Frame, Light, Material, Projection, Ray, Renderer, SceneQuery, Settings,
-};
+use rt_core::{Camera, ColorMap, Frame, Projection, Ray, SceneQuery};
+use rt_surface::{Light, Material, Mesh, Paint, Renderer, Settings, SurfaceScene};
 
 use crate::{
     Section,
@@ -64,8 +63,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let t = scenes::terrain(n);
     let heights: Vec<f32> = t.positions.iter().map(|p| p.y).collect();
     let (lo, hi) = heights.iter().fold((f32::MAX, f32::MIN), |(a, b), &h| (a.min(h), b.max(h)));
-    let mesh =
-        TriangleMesh::new(t.positions, t.indices, Some(heights)).map_err(|e| e.to_string())?;
+    let mesh = Mesh::new(t.positions, t.indices, Some(heights)).map_err(|e| e.to_string())?;
     let map = ColorMap::viridis().with_range(lo, hi).map_err(|e| e.to_string())?;
     let scene = SurfaceScene::build(
         vec![(mesh, Paint::Mapped(map), Material::MATTE)],
@@ -89,7 +87,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let primary: Vec<Ray> = (0..size * size)
         .map(|i| cam.generate_ray(i % size, i / size, Vec2::splat(0.5), Vec2::ZERO))
         .collect();
-    let b = rt_core::ShadeScene::bounds(&scene);
+    let b = rt_surface::ShadeScene::bounds(&scene);
     let incoherent = scenes::incoherent_rays(b.min, b.max, (size * size) as usize, 0x5eed);
     let primary_rate = traversal_rate(&scene, &primary);
     let incoherent_rate = traversal_rate(&scene, &incoherent);

@@ -32,7 +32,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let h = f.grid().spacing().x;
     // Converged reference: RK4 at a quarter voxel, 256 photons per pixel,
     // skipping only where the per-node deflection bound is below 1e-9.
-    let mut reference = Film::new(FILM, FILM, Filter::Box).map_err(str::to_string)?;
+    let mut reference = Film::new(FILM, FILM, Filter::Box).map_err(|e| e.to_string())?;
     let rb = knife_bench(TraceParams::fixed(Method::Rk4, 0.25 * h), 16);
     rb.render_with(
         &|o, d| trace_skipping(&f, &tree, o, d, &rb.params, 1e-9),
@@ -55,9 +55,9 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             // Best of 3 (the film of the last run is kept; all are equal).
             let b = knife_bench(params, k);
             let mut samples = Samples::default();
-            let mut film = Film::new(FILM, FILM, Filter::Box).map_err(str::to_string)?;
+            let mut film = Film::new(FILM, FILM, Filter::Box).map_err(|e| e.to_string())?;
             for _ in 0..3 {
-                film = Film::new(FILM, FILM, Filter::Box).map_err(str::to_string)?;
+                film = Film::new(FILM, FILM, Filter::Box).map_err(|e| e.to_string())?;
                 let (t, r) = if name == "original" {
                     time(|| b.render_with(&|o, d| trace(&f, o, d, &b.params), &mut film, 0, 7))
                 } else {

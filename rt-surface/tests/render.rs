@@ -1,21 +1,22 @@
 //! The surface renderer against answers computed independently.
 
-use rt_accel::{BuildParams, Glyphs, Paint, SceneError, SurfaceScene, TriangleMesh, Tube};
-use rt_core::{
-    Camera, ColorMap, ColorStop, Frame, Light, Material, Projection, Renderer, Settings,
-    glam::Vec3, intersect::Sphere,
+use rt_accel::BuildParams;
+use rt_core::{Camera, ColorMap, ColorStop, Frame, Projection, glam::Vec3, intersect::Sphere};
+use rt_surface::{
+    Glyphs, Light, Material, MaterialError, Mesh, MeshError, ObjectKind, Paint, Renderer,
+    SceneError, Settings, SurfaceScene, Tube,
 };
 
-fn quad(corners: [Vec3; 4]) -> TriangleMesh {
-    TriangleMesh::new(corners.to_vec(), vec![[0, 1, 2], [0, 2, 3]], None).unwrap()
+fn quad(corners: [Vec3; 4]) -> Mesh {
+    Mesh::new(corners.to_vec(), vec![[0, 1, 2], [0, 2, 3]], None).unwrap()
 }
 
 /// A floor `y = 0` (±50), front face up.
-fn floor() -> TriangleMesh {
+fn floor() -> Mesh {
     floor_of(50.0)
 }
 
-fn floor_of(s: f32) -> TriangleMesh {
+fn floor_of(s: f32) -> Mesh {
     quad([
         Vec3::new(-s, 0.0, -s),
         Vec3::new(-s, 0.0, s),
@@ -24,15 +25,11 @@ fn floor_of(s: f32) -> TriangleMesh {
     ])
 }
 
-fn solid(
-    mesh: TriangleMesh,
-    rgb: [f32; 3],
-    m: Material,
-) -> (TriangleMesh, Paint<'static>, Material) {
+fn solid(mesh: Mesh, rgb: [f32; 3], m: Material) -> (Mesh, Paint<'static>, Material) {
     (mesh, Paint::Solid(rgb), m)
 }
 
-fn scene(meshes: Vec<(TriangleMesh, Paint<'static>, Material)>) -> SurfaceScene<'static> {
+fn scene(meshes: Vec<(Mesh, Paint<'static>, Material)>) -> SurfaceScene<'static> {
     SurfaceScene::build(meshes, vec![], vec![], &BuildParams::medium()).unwrap()
 }
 
@@ -182,7 +179,7 @@ fn colour_maps_the_interpolated_scalar_not_interpolated_colours() {
     ];
     let map = ColorMap::from_stops(&STOPS, 0.0, 1.0).unwrap();
     // Scalar 0 at x = 0, 1 at x = 1, linear in x.
-    let mesh = TriangleMesh::new(
+    let mesh = Mesh::new(
         vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 0.0)],
         vec![[0, 1, 2]],
         Some(vec![0.0, 0.0, 1.0]),
@@ -388,10 +385,10 @@ fn bad_geometry_is_named_and_moving_vertices_refits() {
     let good = floor();
     let mut pts = floor().positions().to_vec();
     pts[2].y = f32::NAN;
-    // TriangleMesh itself names the vertex...
+    // Mesh itself names the vertex...
     assert_eq!(
-        TriangleMesh::new(pts.clone(), vec![[0, 1, 2]], None),
-        Err(rt_accel::BuildError::NonFiniteVertex { vertex: 2 })
+        Mesh::new(pts.clone(), vec![[0, 1, 2]], None),
+        Err(MeshError::Geometry(rt_accel::BuildError::NonFiniteVertex { vertex: 2 }))
     );
     // ...and so does the scene, with the object.
     let g = Glyphs {
@@ -404,7 +401,7 @@ fn bad_geometry_is_named_and_moving_vertices_refits() {
     assert_eq!(
         e,
         SceneError::Build {
-            kind: "glyphs",
+            kind: ObjectKind::Glyphs,
             object: 0,
             error: rt_accel::BuildError::InvalidPrimitive { index: 1 }
         }
@@ -417,7 +414,10 @@ fn bad_geometry_is_named_and_moving_vertices_refits() {
         &BuildParams::medium(),
     )
     .unwrap_err();
-    assert!(matches!(e, SceneError::Material { kind: "mesh", object: 0, .. }));
+    assert_eq!(
+        e,
+        SceneError::Material { kind: ObjectKind::Mesh, object: 0, error: MaterialError::Opacity }
+    );
     // Moving the floor up by 1 is a refit, and rays see it there.
     let mut s = scene(vec![
         solid(floor(), [1.0; 3], Material::MATTE),
@@ -433,14 +433,14 @@ fn bad_geometry_is_named_and_moving_vertices_refits() {
     assert!(matches!(
         s.set_mesh_positions(1, &nan),
         Err(SceneError::Build {
-            kind: "mesh",
+            kind: ObjectKind::Mesh,
             object: 1,
             error: rt_accel::BuildError::NonFiniteVertex { vertex: 3 }
         })
     ));
     assert_eq!(s.set_mesh_positions(7, &up), Err(SceneError::NoSuchMesh(7)));
     // New topology is a rebuild.
-    let tri = TriangleMesh::new(up[..3].to_vec(), vec![[0, 1, 2]], None).unwrap();
+    let tri = Mesh::new(up[..3].to_vec(), vec![[0, 1, 2]], None).unwrap();
     s.replace_mesh(1, tri).unwrap();
     assert_eq!((s.refits(), s.rebuilds(), s.triangle_count()), (1, 1, 3));
 }

@@ -2,9 +2,13 @@
 //! are known exactly, and every kind of bad file an `Err`.
 
 use glam::Vec3;
-use rt_accel::{
-    BuildError,
-    io::{ReadError, parse_obj, parse_ply, parse_vtk_legacy, parse_vtk_xml, read_mesh},
+use rt_accel::BuildError;
+use rt_surface::{
+    Mesh, MeshError,
+    io::{
+        MeshData, ReadError, ReadErrorKind, parse_obj, parse_ply, parse_vtk_legacy, parse_vtk_xml,
+        read_mesh, write_ply,
+    },
 };
 
 /// A unit square in z = 0 split into two triangles along (0,0)–(1,1), the
@@ -143,39 +147,59 @@ fn vtk_xml_polydata() {
 
 #[test]
 fn read_mesh_goes_by_extension_and_names_io_errors() {
-    let dir = std::env::temp_dir().join(format!("rt-accel-io-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("rt-surface-io-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let obj = dir.join("t.OBJ");
     std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     assert_eq!(read_mesh(&obj).unwrap().indices, [[0, 1, 2]]);
     let missing = dir.join("none.ply");
-    match read_mesh(&missing) {
-        Err(ReadError::Io { path, .. }) => assert!(path.ends_with("none.ply")),
+    let e = read_mesh(&missing).unwrap_err();
+    let ReadErrorKind::Io(source) = e.kind() else { panic!("{e:?}") };
+    assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
+    assert_eq!(e.path(), Some(missing.as_path()));
+    // The system's error is the source, the path leads the message.
+    assert!(core::error::Error::source(&e).is_some());
+    assert!(e.to_string().starts_with(&format!("{}: ", missing.display())), "{e}");
+    // A parse error in a named file names it too.
+    let bad = dir.join("bad.ply");
+    std::fs::write(&bad, "plx\n").unwrap();
+    let e = read_mesh(&bad).unwrap_err();
+    assert!(matches!(e.kind(), ReadErrorKind::Malformed { .. }), "{e:?}");
+    assert!(e.to_string().starts_with(&format!("{}: malformed", bad.display())), "{e}");
+    let e = read_mesh(&dir.join("t.stl")).unwrap_err();
+    assert!(matches!(e.kind(), ReadErrorKind::UnknownFormat), "{e:?}");
+    assert!(e.to_string().starts_with(&format!("{}: ", dir.join("t.stl").display())));
+    assert!(e.to_string().contains(".obj, .ply, .vtk or .vtp"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The mesh error inside a reader's error.
+fn mesh_error<T: core::fmt::Debug>(r: Result<T, ReadError>) -> MeshError {
+    match r.map_err(ReadError::into_kind) {
+        Err(ReadErrorKind::Mesh(e)) => e,
         other => panic!("{other:?}"),
     }
-    assert!(matches!(read_mesh(&dir.join("t.stl")), Err(ReadError::Unsupported(_))));
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn bad_geometry_names_the_vertex_or_triangle() {
     let nan = parse_obj(b"v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
-    assert_eq!(
-        nan.into_mesh(None),
-        Err(ReadError::Mesh(BuildError::NonFiniteVertex { vertex: 1 }))
-    );
+    assert!(matches!(
+        mesh_error(nan.into_mesh(None)),
+        MeshError::Geometry(BuildError::NonFiniteVertex { vertex: 1 })
+    ));
 
     let mut ply = ply_header("ascii", "");
     ply += "0 0 0 0 0 1 0 0\n1 0 0 0 0 1 0 0\n0 1 0 0 0 1 0 0\n0 0 1 0 0 0 0 0\n3 0 1 2\n";
     // Vertex 3's normal is zero.
     let data = parse_ply(ply.as_bytes()).unwrap();
-    assert_eq!(data.into_mesh(None), Err(ReadError::Mesh(BuildError::BadNormal { vertex: 3 })));
+    assert_eq!(mesh_error(data.into_mesh(None)), MeshError::BadNormal { vertex: 3 });
 
     let far = ply.replace("3 0 1 2\n", "3 0 1 9\n");
     let data = parse_ply(far.as_bytes()).unwrap();
     assert_eq!(
-        data.into_mesh(None),
-        Err(ReadError::Mesh(BuildError::IndexOutOfRange { triangle: 0, index: 9 }))
+        mesh_error(data.into_mesh(None)),
+        MeshError::Geometry(BuildError::IndexOutOfRange { triangle: 0, index: 9 })
     );
 
     // An index past its own object must not land on the next object's
@@ -183,8 +207,8 @@ fn bad_geometry_names_the_vertex_or_triangle() {
     let vtk = b"# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\n\
         POINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0 1 3\n";
     assert_eq!(
-        parse_vtk_legacy(vtk),
-        Err(ReadError::Mesh(BuildError::IndexOutOfRange { triangle: 0, index: 3 }))
+        mesh_error(parse_vtk_legacy(vtk)),
+        MeshError::Geometry(BuildError::IndexOutOfRange { triangle: 0, index: 3 })
     );
 }
 
@@ -192,8 +216,8 @@ fn bad_geometry_names_the_vertex_or_triangle() {
 fn missing_scalar_lists_the_available_ones() {
     let data =
         parse_obj(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n").unwrap();
-    match data.into_mesh(Some("temperature")) {
-        Err(ReadError::NoSuchScalar { name, available }) => {
+    match data.into_mesh(Some("temperature")).map_err(ReadError::into_kind) {
+        Err(ReadErrorKind::NoSuchScalar { name, available }) => {
             assert_eq!(name, "temperature");
             assert_eq!(available, ["u", "v"]);
         }
@@ -247,7 +271,7 @@ fn malformed_files_are_errors() {
         assert!(!result.unwrap_err().to_string().is_empty(), "{what}");
     }
     // An empty file is a valid, empty mesh.
-    assert_eq!(parse_obj(b"").unwrap(), rt_accel::io::MeshData::default());
+    assert_eq!(parse_obj(b"").unwrap(), MeshData::default());
 }
 
 /// Found by the `read_obj` fuzz target: `tobj` overflows computing a
@@ -269,5 +293,46 @@ fn fuzz_regression_obj_bad_texcoord_index_is_an_error() {
     ];
     let bytes = parts.concat();
     assert_eq!(bytes.len(), 375);
-    assert!(matches!(parse_obj(&bytes), Err(ReadError::Malformed(_))));
+    assert!(matches!(parse_obj(&bytes).unwrap_err().kind(), ReadErrorKind::Malformed { .. }));
+}
+
+/// Parse errors wrap the parser's own error as their source.
+#[test]
+fn parser_errors_are_the_source() {
+    for e in [
+        parse_obj(b"v 0 zero 0\n").unwrap_err(),
+        parse_ply(b"plx\nformat ascii 1.0\nend_header\n").unwrap_err(),
+        parse_vtk_legacy(b"# vtk DataFile Version 3.0\n\xff\xfe").unwrap_err(),
+    ] {
+        assert!(matches!(e.kind(), ReadErrorKind::Malformed { source: Some(_), .. }), "{e:?}");
+        let inner = core::error::Error::source(&e).expect("source");
+        assert!(e.to_string().ends_with(&inner.to_string()), "{e} / {inner}");
+    }
+}
+
+/// What `write_ply` writes, `parse_ply` reads back exactly: positions,
+/// normals, the scalar under its name, triangles.
+#[test]
+fn ply_round_trip() {
+    let positions = vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 1e-7)];
+    let normals = vec![Vec3::Z, Vec3::Z, Vec3::new(0.0, 0.6, 0.8), Vec3::Z];
+    let mesh = Mesh::new(positions, QUAD.to_vec(), Some(vec![0.5, -1.0, f32::MAX, 3.25]))
+        .unwrap()
+        .with_normals(normals)
+        .unwrap();
+    let mut bytes = Vec::new();
+    write_ply(&mesh, "pressure", &mut bytes).unwrap();
+    let data = parse_ply(&bytes).unwrap();
+    assert_eq!(data.scalar_names().collect::<Vec<_>>(), ["pressure"]);
+    assert_eq!(data.into_mesh(Some("pressure")).unwrap(), mesh);
+    // Without scalars or normals too.
+    let plain = Mesh::new(mesh.positions().to_vec(), QUAD.to_vec(), None).unwrap();
+    bytes.clear();
+    write_ply(&plain, "unused name", &mut bytes).unwrap();
+    assert_eq!(parse_ply(&bytes).unwrap().into_mesh(None).unwrap(), plain);
+    // A name that would break the header is refused.
+    for bad in ["", "two words", "x", "nz"] {
+        let e = write_ply(&mesh, bad, &mut Vec::new()).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::InvalidInput, "{bad:?}");
+    }
 }

@@ -1,118 +1,20 @@
-//! A shadeable scene of meshes, sphere glyphs and tubes with materials.
+//! The scene: one BVH per primitive kind, the objects' paints and
+//! materials, refits for moved vertices and rebuilds for new topology.
 
 use alloc::vec::Vec;
 use core::fmt;
 
 use glam::Vec3;
-use rt_core::{
-    Aabb, ColorMap, Hit, Material, PrimKind, Ray, SceneQuery, ShadeScene, Surface,
-    intersect::{Capsule, Sphere},
+use rt_accel::{
+    BuildError, BuildParams, Bvh, Scene, build_capsules, build_spheres, build_triangles,
 };
+use rt_core::{Aabb, Hit, PrimKind, Ray, SceneQuery, intersect::Capsule};
 
-use crate::{BuildError, BuildParams, Scene, TriangleMesh, build_capsules, build_spheres};
-
-/// How a surface gets its colour.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Paint<'m> {
-    /// One linear RGB colour.
-    Solid([f32; 3]),
-    /// The object's scalar (interpolated across the primitive first)
-    /// through a colour map; objects without scalars get its NaN colour.
-    Mapped(ColorMap<'m>),
-}
-
-impl Paint<'_> {
-    fn color(&self, scalar: Option<f32>) -> [f32; 3] {
-        match self {
-            Self::Solid(c) => *c,
-            Self::Mapped(m) => {
-                let c = m.map(scalar.unwrap_or(f32::NAN));
-                [c[0], c[1], c[2]]
-            }
-        }
-    }
-}
-
-/// Sphere glyphs (points, atoms), with an optional scalar each.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Glyphs<'m> {
-    /// The spheres.
-    pub spheres: Vec<Sphere>,
-    /// One scalar per sphere, for [`Paint::Mapped`].
-    pub scalars: Option<Vec<f32>>,
-    /// Colour.
-    pub paint: Paint<'m>,
-    /// Material.
-    pub material: Material,
-}
-
-/// A tube along a polyline (a streamline), with optional scalars at the
-/// points, interpolated along each segment.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Tube<'m> {
-    /// The polyline (at least 2 points).
-    pub points: Vec<Vec3>,
-    /// Tube radius.
-    pub radius: f32,
-    /// One scalar per point, for [`Paint::Mapped`].
-    pub scalars: Option<Vec<f32>>,
-    /// Colour.
-    pub paint: Paint<'m>,
-    /// Material.
-    pub material: Material,
-}
-
-/// Why a [`SurfaceScene`] could not be built or changed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SceneError {
-    /// Building or refitting a BVH failed (names the vertex or primitive,
-    /// counted within the object).
-    Build {
-        /// Which object: `"mesh"`, `"glyphs"` or `"tube"`.
-        kind: &'static str,
-        /// Its index among objects of that kind.
-        object: usize,
-        /// What was wrong.
-        error: BuildError,
-    },
-    /// A material parameter out of range.
-    Material {
-        /// Which object kind.
-        kind: &'static str,
-        /// Its index.
-        object: usize,
-        /// The parameter.
-        what: &'static str,
-    },
-    /// Glyph or tube scalars whose count does not match, a tube of fewer
-    /// than 2 points.
-    Shape {
-        /// Which object kind.
-        kind: &'static str,
-        /// Its index.
-        object: usize,
-    },
-    /// No mesh with that index.
-    NoSuchMesh(usize),
-}
-
-impl fmt::Display for SceneError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Build { kind, object, error } => write!(f, "{kind} {object}: {error}"),
-            Self::Material { kind, object, what } => write!(f, "{kind} {object}: {what}"),
-            Self::Shape { kind, object } => {
-                write!(f, "{kind} {object}: scalar count does not match, or too few points")
-            }
-            Self::NoSuchMesh(i) => write!(f, "no mesh {i}"),
-        }
-    }
-}
-
-impl core::error::Error for SceneError {}
+use super::{Glyphs, ObjectKind, Paint, SceneBuilder, SceneError, Tube};
+use crate::{Material, Mesh, ShadeScene, Surface};
 
 struct MeshPart<'m> {
-    mesh: TriangleMesh,
+    mesh: Mesh,
     paint: Paint<'m>,
     material: Material,
     first_triangle: u32,
@@ -156,25 +58,25 @@ impl<'m> SurfaceScene<'m> {
     /// [`SceneError`] naming the object (and, for bad geometry, the vertex
     /// or primitive within it).
     pub fn build(
-        meshes: Vec<(TriangleMesh, Paint<'m>, Material)>,
+        meshes: Vec<(Mesh, Paint<'m>, Material)>,
         glyphs: Vec<Glyphs<'m>>,
         tubes: Vec<Tube<'m>>,
         params: &BuildParams,
     ) -> Result<Self, SceneError> {
         let material = |kind, object, m: &Material| {
-            m.validate().map_err(|what| SceneError::Material { kind, object, what })
+            m.validate().map_err(|error| SceneError::Material { kind, object, error })
         };
         let mut parts = Vec::with_capacity(meshes.len());
         for (i, (mesh, paint, m)) in meshes.into_iter().enumerate() {
-            material("mesh", i, &m)?;
+            material(ObjectKind::Mesh, i, &m)?;
             parts.push(MeshPart { mesh, paint, material: m, first_triangle: 0, first_vertex: 0 });
         }
         let mut spheres = Vec::new();
         let mut placed_glyphs = Vec::with_capacity(glyphs.len());
         for (i, g) in glyphs.into_iter().enumerate() {
-            material("glyphs", i, &g.material)?;
+            material(ObjectKind::Glyphs, i, &g.material)?;
             if g.scalars.as_ref().is_some_and(|s| s.len() != g.spheres.len()) {
-                return Err(SceneError::Shape { kind: "glyphs", object: i });
+                return Err(SceneError::Shape { kind: ObjectKind::Glyphs, object: i });
             }
             let first = spheres.len() as u32;
             spheres.extend_from_slice(&g.spheres);
@@ -183,9 +85,9 @@ impl<'m> SurfaceScene<'m> {
         let mut capsules = Vec::new();
         let mut placed_tubes = Vec::with_capacity(tubes.len());
         for (i, t) in tubes.into_iter().enumerate() {
-            material("tube", i, &t.material)?;
+            material(ObjectKind::Tube, i, &t.material)?;
             if t.points.len() < 2 || t.scalars.as_ref().is_some_and(|s| s.len() != t.points.len()) {
-                return Err(SceneError::Shape { kind: "tube", object: i });
+                return Err(SceneError::Shape { kind: ObjectKind::Tube, object: i });
             }
             let first = capsules.len() as u32;
             capsules.extend(t.points.windows(2).map(|w| Capsule::new(w[0], w[1], t.radius)));
@@ -206,11 +108,11 @@ impl<'m> SurfaceScene<'m> {
         let sphere_firsts: Vec<u32> = placed_glyphs.iter().map(|g| g.1).collect();
         let tube_firsts: Vec<u32> = placed_tubes.iter().map(|t| t.1).collect();
         let scene = Scene {
-            triangles: crate::Bvh::empty(),
+            triangles: Bvh::empty(),
             spheres: build_spheres(&spheres, params)
-                .map_err(|e| locate("glyphs", &sphere_firsts, e))?,
+                .map_err(|e| locate(ObjectKind::Glyphs, &sphere_firsts, e))?,
             capsules: build_capsules(&capsules, params)
-                .map_err(|e| locate("tube", &tube_firsts, e))?,
+                .map_err(|e| locate(ObjectKind::Tube, &tube_firsts, e))?,
         };
         let mut s = Self {
             scene,
@@ -228,12 +130,29 @@ impl<'m> SurfaceScene<'m> {
         Ok(s)
     }
 
+    /// The short way to assemble a scene: add objects, then
+    /// [`SceneBuilder::build`].
+    pub fn builder() -> SceneBuilder<'m> {
+        SceneBuilder::new()
+    }
+
+    /// A scene of one matte mesh, BVH built with [`BuildParams::medium`].
+    ///
+    /// # Errors
+    /// As [`SurfaceScene::build`].
+    pub fn from_mesh(mesh: impl Into<Mesh>, paint: Paint<'m>) -> Result<Self, SceneError> {
+        Self::builder().mesh(mesh, paint, Material::MATTE).build()
+    }
+
     /// Concatenates the meshes and builds their BVH.
     fn rebuild_triangles(&mut self) -> Result<(), SceneError> {
         let (mut positions, mut indices) = (Vec::new(), Vec::new());
         for (i, part) in self.meshes.iter_mut().enumerate() {
-            let too_many =
-                SceneError::Build { kind: "mesh", object: i, error: BuildError::TooManyPrimitives };
+            let too_many = SceneError::Build {
+                kind: ObjectKind::Mesh,
+                object: i,
+                error: BuildError::TooManyPrimitives,
+            };
             part.first_vertex = u32::try_from(positions.len()).map_err(|_| too_many)?;
             part.first_triangle = u32::try_from(indices.len()).map_err(|_| too_many)?;
             let base = part.first_vertex;
@@ -244,7 +163,7 @@ impl<'m> SurfaceScene<'m> {
                 indices.push([a, b, c]);
             }
         }
-        let bvh = crate::build_triangles(&positions, &indices, &self.params).map_err(|error| {
+        let bvh = build_triangles(&positions, &indices, &self.params).map_err(|error| {
             // Name the mesh and its own vertex.
             self.locate(error)
         })?;
@@ -264,7 +183,7 @@ impl<'m> SurfaceScene<'m> {
             }
             e => (0, e),
         };
-        SceneError::Build { kind: "mesh", object, error }
+        SceneError::Build { kind: ObjectKind::Mesh, object, error }
     }
 
     /// Moves mesh `index`'s vertices (same count, same triangles) and
@@ -280,7 +199,7 @@ impl<'m> SurfaceScene<'m> {
     ) -> Result<(), SceneError> {
         let part = self.meshes.get_mut(index).ok_or(SceneError::NoSuchMesh(index))?;
         part.mesh.set_positions(positions).map_err(|error| SceneError::Build {
-            kind: "mesh",
+            kind: ObjectKind::Mesh,
             object: index,
             error,
         })?;
@@ -289,7 +208,7 @@ impl<'m> SurfaceScene<'m> {
         self.scene
             .triangles
             .refit_triangles(&self.positions, &self.indices)
-            .map_err(|error| SceneError::Build { kind: "mesh", object: index, error })?;
+            .map_err(|error| SceneError::Build { kind: ObjectKind::Mesh, object: index, error })?;
         self.refits += 1;
         Ok(())
     }
@@ -299,7 +218,7 @@ impl<'m> SurfaceScene<'m> {
     /// # Errors
     /// [`SceneError::NoSuchMesh`], or a build error; the old mesh stays on
     /// error.
-    pub fn replace_mesh(&mut self, index: usize, mesh: TriangleMesh) -> Result<(), SceneError> {
+    pub fn replace_mesh(&mut self, index: usize, mesh: Mesh) -> Result<(), SceneError> {
         let part = self.meshes.get_mut(index).ok_or(SceneError::NoSuchMesh(index))?;
         let old = core::mem::replace(&mut part.mesh, mesh);
         if let Err(e) = self.rebuild_triangles() {

@@ -1,0 +1,205 @@
+//! One pixel's light: the camera ray, translucent layers composited front
+//! to back, Blinn–Phong from each light with hard shadows, ambient
+//! occlusion and mirror bounces. Each pixel draws from its own random
+//! stream, so the image does not depend on which thread renders it.
+
+use alloc::vec::Vec;
+
+use glam::{Vec2, Vec3};
+use rt_core::{
+    Aabb, Camera, Hit, Ray,
+    camera::cosine_hemisphere,
+    intersect::{spawn_ray, spawn_ray_to},
+    sampling::{Rng, rng_for, uniform2},
+};
+
+use super::{Light, Material, RayCounts, Settings, ShadeScene, Surface, TILE};
+use crate::math::{powf, sqrt};
+
+pub(super) struct TileResult {
+    pub(super) x0: u32,
+    pub(super) y0: u32,
+    pub(super) w: u32,
+    pub(super) pixels: Vec<([f32; 4], f32)>,
+    pub(super) counts: RayCounts,
+}
+
+/// What one pass shares between tiles.
+pub(super) struct Ctx<'a, S> {
+    pub(super) scene: &'a S,
+    pub(super) camera: &'a Camera,
+    pub(super) settings: &'a Settings,
+    pub(super) bounds: Aabb,
+}
+
+/// Per-pixel state: its random stream and its counts.
+struct PixelWork {
+    rng: Rng,
+    counts: RayCounts,
+}
+
+impl<S: ShadeScene> Ctx<'_, S> {
+    pub(super) fn tile(&self, x0: u32, y0: u32, pass: u32) -> TileResult {
+        let (w, h) = (self.camera.width, self.camera.height);
+        let (tw, th) = (TILE.min(w - x0), TILE.min(h - y0));
+        let mut pixels = Vec::with_capacity((tw * th) as usize);
+        let stream_seed = self.settings.seed ^ u64::from(pass).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        let mut pw = PixelWork { rng: rng_for(stream_seed, 0), counts: RayCounts::default() };
+        for y in y0..y0 + th {
+            for x in x0..x0 + tw {
+                pw.rng = rng_for(stream_seed, u64::from(y) * u64::from(w) + u64::from(x));
+                let jitter = if pass == 0 { Vec2::splat(0.5) } else { uniform2(&mut pw.rng) };
+                let ray = self.camera.generate_ray(x, y, jitter, uniform2(&mut pw.rng));
+                pw.counts.primary += 1;
+                let (rgb, a, depth) = self.path(ray, 0, &mut pw);
+                pixels.push(([rgb.x, rgb.y, rgb.z, a], depth));
+            }
+        }
+        TileResult { x0, y0, w: tw, pixels, counts: pw.counts }
+    }
+
+    /// The closest hit, not traversing rays that miss the scene's box.
+    fn closest(&self, ray: &Ray, pw: &mut PixelWork) -> Option<Hit> {
+        if self.bounds.intersect_ray(ray).is_none() {
+            pw.counts.culled += 1;
+            return None;
+        }
+        self.scene.closest_hit(ray)
+    }
+
+    fn occluded(&self, ray: &Ray, pw: &mut PixelWork) -> bool {
+        if self.bounds.intersect_ray(ray).is_none() {
+            pw.counts.culled += 1;
+            return false;
+        }
+        self.scene.occluded(ray)
+    }
+
+    /// Premultiplied colour, alpha and depth seen along `ray`: translucent
+    /// layers composited front to back.
+    fn path(&self, mut ray: Ray, bounce: u32, pw: &mut PixelWork) -> (Vec3, f32, f32) {
+        let (mut rgb, mut alpha, mut depth) = (Vec3::ZERO, 0.0f32, f32::INFINITY);
+        // Distance along the first ray to the current ray's origin.
+        let mut travelled = 0.0;
+        let mut layers = 0;
+        while let Some(hit) = self.closest(&ray, pw) {
+            let s = self.scene.surface(&hit);
+            let opacity = s.material.opacity;
+            if opacity > 0.0 {
+                if depth.is_infinite() {
+                    depth = travelled + hit.t;
+                }
+                let c = self.shade(&ray, &hit, &s, bounce, pw);
+                rgb += (1.0 - alpha) * opacity * c;
+                alpha += (1.0 - alpha) * opacity;
+            }
+            if alpha >= 1.0 || layers >= self.settings.max_layers {
+                break;
+            }
+            // On through the surface, same direction.
+            layers += 1;
+            pw.counts.transparency += 1;
+            let next = spawn_ray(hit.position, hit.position_error, hit.normal, ray.direction);
+            travelled += (next.origin - ray.origin).length();
+            ray = next;
+        }
+        (rgb, alpha, depth)
+    }
+
+    /// Linear RGB leaving the surface toward the viewer.
+    fn shade(&self, ray: &Ray, hit: &Hit, s: &Surface, bounce: u32, pw: &mut PixelWork) -> Vec3 {
+        let d = ray.direction.normalize();
+        // Both normals face the viewer.
+        let ng = if hit.normal.dot(d) > 0.0 { -hit.normal } else { hit.normal };
+        let n = if s.normal.dot(ng) < 0.0 { -s.normal } else { s.normal };
+        let (p, err) = (hit.position, hit.position_error);
+        let albedo = Vec3::from_array(s.albedo);
+        let m = &s.material;
+        let mut ao = None;
+        let mut c = Vec3::ZERO;
+        for light in &self.settings.lights {
+            match *light {
+                Light::Ambient { color } => {
+                    let k = *ao.get_or_insert_with(|| self.ambient_occlusion(p, err, ng, pw));
+                    c += k * albedo * Vec3::from_array(color);
+                }
+                Light::Directional { direction: l, color } => {
+                    let lit = self.settings.shadows.then(|| spawn_ray(p, err, ng, l));
+                    c += self.direct(n, d, l, 1.0, lit, albedo, m, color, pw);
+                }
+                Light::Point { position, color } => {
+                    let to = position - p;
+                    let d2 = to.length_squared();
+                    if d2 > 0.0 {
+                        let lit = self.settings.shadows.then(|| spawn_ray_to(p, err, ng, position));
+                        c += self.direct(n, d, to / sqrt(d2), 1.0 / d2, lit, albedo, m, color, pw);
+                    }
+                }
+            }
+        }
+        if m.mirror > 0.0 && bounce < self.settings.max_bounces {
+            pw.counts.reflection += 1;
+            let r = d - 2.0 * d.dot(n) * n;
+            let (rgb, a, _) = self.path(spawn_ray(p, err, ng, r), bounce + 1, pw);
+            let seen = rgb + (1.0 - a) * Vec3::from_array(self.settings.environment);
+            c = (1.0 - m.mirror) * c + m.mirror * seen;
+        }
+        c
+    }
+
+    /// Blinn–Phong from one light in direction `l` (unit) scaled by
+    /// `falloff`; `shadow` is the ray to test when shadows are on.
+    #[allow(clippy::too_many_arguments)]
+    fn direct(
+        &self,
+        n: Vec3,
+        d: Vec3,
+        l: Vec3,
+        falloff: f32,
+        shadow: Option<Ray>,
+        albedo: Vec3,
+        m: &Material,
+        color: [f32; 3],
+        pw: &mut PixelWork,
+    ) -> Vec3 {
+        let cos = n.dot(l);
+        if cos <= 0.0 {
+            return Vec3::ZERO;
+        }
+        if let Some(r) = shadow {
+            pw.counts.shadow += 1;
+            if self.occluded(&r, pw) {
+                return Vec3::ZERO;
+            }
+        }
+        let half = (l - d).normalize_or_zero();
+        let spec = if m.specular > 0.0 {
+            m.specular * powf(n.dot(half).max(0.0), m.shininess)
+        } else {
+            0.0
+        };
+        falloff * Vec3::from_array(color) * (m.diffuse * cos * albedo + Vec3::splat(spec))
+    }
+
+    /// The unoccluded fraction of `ao_samples` cosine-weighted rays about
+    /// `ng` (1 with AO off).
+    fn ambient_occlusion(&self, p: Vec3, err: Vec3, ng: Vec3, pw: &mut PixelWork) -> f32 {
+        let n = self.settings.ao_samples;
+        if n == 0 {
+            return 1.0;
+        }
+        let (t, b) = ng.any_orthonormal_pair();
+        let mut open = 0;
+        for _ in 0..n {
+            let l = cosine_hemisphere(uniform2(&mut pw.rng));
+            let w = l.x * t + l.y * b + l.z * ng;
+            let mut r = spawn_ray(p, err, ng, w);
+            r.t_max = self.settings.ao_distance;
+            pw.counts.ao += 1;
+            if !self.occluded(&r, pw) {
+                open += 1;
+            }
+        }
+        open as f32 / n as f32
+    }
+}

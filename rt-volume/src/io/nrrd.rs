@@ -1,0 +1,134 @@
+//! NRRD (the original tool's format): attached or detached raw data.
+
+use alloc::{format, string::ToString, vec::Vec};
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+
+use super::{
+    ReadError, ReadErrorKind,
+    decode::{SampleType, decode, three_f64, three_usize},
+    error::{malformed, unsupported},
+    read,
+};
+use crate::Grid;
+
+/// Reads a NRRD file (`NRRD0001`–`NRRD0005`, 3-D, raw encoding, attached or
+/// detached data). Geometry: `spacings` (or `space directions` that are
+/// axis-aligned), origin from `space origin`, an `origin:=` key/value, or
+/// `axis mins` with cell centring; default origin 0, spacing 1.
+///
+/// # Errors
+/// [`ReadError`] naming the problem.
+pub fn read_nrrd(path: &Path) -> Result<Grid, ReadError> {
+    let bytes = read(path)?;
+    parse_nrrd(&bytes, path.parent()).map_err(|e| e.in_file(path))
+}
+
+/// [`read_nrrd`] from bytes; `dir` resolves detached data files.
+///
+/// # Errors
+/// [`ReadError`] naming the problem.
+pub fn parse_nrrd(bytes: &[u8], dir: Option<&Path>) -> Result<Grid, ReadError> {
+    if !bytes.starts_with(b"NRRD000") {
+        return Err(malformed("not a NRRD file (magic)"));
+    }
+    // The header ends at the first empty line.
+    let end = bytes
+        .windows(2)
+        .position(|w| w == b"\n\n")
+        .ok_or_else(|| malformed("no blank line ends the header"))?;
+    let header =
+        core::str::from_utf8(&bytes[..end]).map_err(|_| malformed("header is not UTF-8"))?;
+    let payload = &bytes[end + 2..];
+    let (mut ty, mut dims, mut little, mut raw) = (None, None, true, false);
+    let (mut spacing, mut origin, mut mins, mut cell, mut data_file) =
+        (DVec3::ONE, None, None, false, None);
+    for line in header.lines().skip(1) {
+        if line.starts_with('#') || line.trim().is_empty() {
+            continue;
+        }
+        if let Some((k, v)) = line.split_once(":=") {
+            if k.trim() == "origin" {
+                origin = Some(three_f64(v, "origin")?);
+            }
+            continue;
+        }
+        let Some((k, v)) = line.split_once(':') else {
+            return Err(malformed(format!("line without a field: `{line}`")));
+        };
+        let v = v.trim();
+        match k.trim() {
+            "type" => {
+                ty = Some(match v {
+                    "float" => SampleType::F32,
+                    "double" => SampleType::F64,
+                    "uchar" | "unsigned char" | "uint8" | "uint8_t" => SampleType::U8,
+                    "short" | "int16" | "int16_t" | "signed short" => SampleType::I16,
+                    "ushort" | "unsigned short" | "uint16" | "uint16_t" => SampleType::U16,
+                    other => return Err(unsupported(format!("type `{other}`"))),
+                })
+            }
+            "dimension" if v != "3" => {
+                return Err(unsupported(format!("dimension {v} (only 3)")));
+            }
+            "sizes" => dims = Some(three_usize(v, "sizes")?),
+            "spacings" => spacing = three_f64(v, "spacings")?,
+            "space directions" => {
+                let rows: Vec<DVec3> = v
+                    .split(')')
+                    .filter(|t| t.contains('('))
+                    .map(|t| three_f64(t, "space directions"))
+                    .collect::<Result<_, _>>()?;
+                if rows.len() != 3 {
+                    return Err(malformed("space directions needs 3 vectors"));
+                }
+                for (a, r) in rows.iter().enumerate() {
+                    let off: f64 = (0..3).filter(|&b| b != a).map(|b| r[b].abs()).sum();
+                    if off != 0.0 {
+                        return Err(unsupported("non-axis-aligned space directions"));
+                    }
+                    spacing[a] = r[a];
+                }
+            }
+            "space origin" => origin = Some(three_f64(v, "space origin")?),
+            "axis mins" => mins = Some(three_f64(v, "axis mins")?),
+            "centers" | "centerings" => cell = v.split_whitespace().all(|c| c == "cell"),
+            "endian" => little = v == "little",
+            "encoding" => {
+                raw = v == "raw";
+                if !raw {
+                    return Err(unsupported(format!("encoding `{v}` (only raw)")));
+                }
+            }
+            "data file" | "datafile" => data_file = Some(v.to_string()),
+            _ => {}
+        }
+    }
+    let ty = ty.ok_or_else(|| malformed("no `type`"))?;
+    let dims = dims.ok_or_else(|| malformed("no `sizes`"))?;
+    if !raw {
+        return Err(malformed("no `encoding`"));
+    }
+    let origin = origin.unwrap_or_else(|| match mins {
+        Some(m) if cell => m + 0.5 * spacing,
+        Some(m) => m,
+        None => DVec3::ZERO,
+    });
+    let count = dims[0]
+        .checked_mul(dims[1])
+        .and_then(|v| v.checked_mul(dims[2]))
+        .filter(|&v| v <= Grid::MAX_SAMPLES)
+        .ok_or(ReadError::from(ReadErrorKind::TooLarge))?;
+    let detached;
+    let payload = match data_file {
+        Some(f) => {
+            let p = dir.map_or_else(|| PathBuf::from(&f), |d| d.join(&f));
+            detached = read(&p)?;
+            &detached[..]
+        }
+        None => payload,
+    };
+    let data = decode(payload, ty, little, count)?;
+    Ok(Grid::new(dims, origin, spacing, data)?)
+}
