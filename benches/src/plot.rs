@@ -1,11 +1,49 @@
 //! Minimal log–log line plots as PNG (no text: the report's tables carry
 //! the numbers; colours are listed next to each plot).
 
-use std::path::Path;
+use std::{fmt, path::Path};
 
-use rt_core::{Frame, Pixel};
+use rt_core::{Frame, FrameError, Pixel};
 
-use crate::image::write_png;
+use crate::image::{WriteError, write_png};
+
+/// Why a plot could not be drawn.
+#[derive(Debug)]
+pub enum PlotError {
+    /// No point with both coordinates finite and positive.
+    Empty,
+    /// The image could not be made (zero or huge size).
+    Frame(FrameError),
+    /// The PNG could not be written.
+    Write(WriteError),
+}
+
+impl fmt::Display for PlotError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Empty => f.write_str("nothing to plot"),
+            Self::Frame(e) => write!(f, "plot image: {e}"),
+            Self::Write(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for PlotError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Self::Empty => None,
+            Self::Frame(e) => Some(e),
+            Self::Write(e) => Some(e),
+        }
+    }
+}
+
+/// For the tools' one-line messages.
+impl From<PlotError> for String {
+    fn from(e: PlotError) -> Self {
+        e.to_string()
+    }
+}
 
 /// One polyline: points `(x, y)` (both > 0) and an RGB colour.
 #[derive(Clone, Debug)]
@@ -31,15 +69,15 @@ pub const PALETTE: [([f32; 3], &str); 6] = [
 /// accurate) get a black ring. Writes a `width × height` PNG.
 ///
 /// # Errors
-/// File or encoding errors, as text.
-pub fn loglog(series: &[Series], width: u32, height: u32, path: &Path) -> Result<(), String> {
+/// [`PlotError`]: nothing to plot, a bad size, or the file.
+pub fn loglog(series: &[Series], width: u32, height: u32, path: &Path) -> Result<(), PlotError> {
     let pts: Vec<(f64, f64)> = series
         .iter()
         .flat_map(|s| s.points.iter().copied())
         .filter(|&(x, y)| x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite())
         .collect();
     if pts.is_empty() {
-        return Err("nothing to plot".into());
+        return Err(PlotError::Empty);
     }
     let lx: Vec<f64> = pts.iter().map(|p| p.0.log10()).collect();
     let ly: Vec<f64> = pts.iter().map(|p| p.1.log10()).collect();
@@ -52,7 +90,7 @@ pub fn loglog(series: &[Series], width: u32, height: u32, path: &Path) -> Result
         ly.iter().copied().fold(f64::MIN, f64::max).ceil(),
     );
     let (x1, y1) = (x1.max(x0 + 1.0), y1.max(y0 + 1.0));
-    let mut frame = Frame::new(width, height).map_err(|e| e.to_string())?;
+    let mut frame = Frame::new(width, height).map_err(PlotError::Frame)?;
     for p in frame.pixels_mut() {
         *p = Pixel { color: [1.0; 4], depth: 0.0 };
     }
@@ -116,5 +154,5 @@ pub fn loglog(series: &[Series], width: u32, height: u32, path: &Path) -> Result
             put(&mut frame, px + 5.0 * a.cos(), py + 5.0 * a.sin(), [0.0; 3]);
         }
     }
-    write_png(&frame, path)
+    write_png(&frame, path).map_err(PlotError::Write)
 }

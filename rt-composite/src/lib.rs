@@ -72,3 +72,8 @@ pub use fragment::{Fragment, Pixel8, over, z_composite};
 pub use mpi;
 pub use schedule::{CompositeError, MessageProblem, Mode, Schedule, Stats, composite, serial_fold};
 pub use sparse::{DecodeError, SparseImage};
+
+/// The crate README's example, compiled and run as a doc test.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

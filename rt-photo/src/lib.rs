@@ -86,3 +86,8 @@ pub use rt_volume::{
 pub use rt_volume;
 /// The `glam` of `rt-volume` and `rt-core` (`DVec3` for beams).
 pub use rt_volume::glam;
+
+/// The crate README's example, compiled and run as a doc test.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -15,7 +15,7 @@ use super::{
 /// one.
 ///
 /// # Errors
-/// [`ReadErrorKind::Malformed`] wrapping `tobj`'s error, or for an index that
+/// [`ReadErrorKind::Malformed`](super::ReadErrorKind::Malformed) wrapping `tobj`'s error, or for an index that
 /// makes `tobj` itself fail.
 pub fn parse_obj(bytes: &[u8]) -> Result<MeshData, ReadError> {
     let options = tobj::LoadOptions {

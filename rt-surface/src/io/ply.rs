@@ -19,7 +19,7 @@ use crate::Mesh;
 /// lists, split into fans. Other elements are ignored.
 ///
 /// # Errors
-/// [`ReadErrorKind::Malformed`] for a file `ply-rs-bw` rejects, no `vertex`
+/// [`ReadErrorKind::Malformed`](super::ReadErrorKind::Malformed) for a file `ply-rs-bw` rejects, no `vertex`
 /// element or coordinates, a face list of fewer than 3 vertices or a
 /// negative index.
 pub fn parse_ply(bytes: &[u8]) -> Result<MeshData, ReadError> {

@@ -106,7 +106,7 @@ impl Renderer {
     ///
     /// # Errors
     /// [`RenderError::Settings`] for out-of-range settings (see
-    /// [`Material::validate`] for materials, checked by scenes), and
+    /// [`Material::validate`](super::Material::validate) for materials, checked by scenes), and
     /// [`RenderError::Frame`] for an image too large.
     pub fn new(camera: Camera, settings: Settings) -> Result<Self, RenderError> {
         settings.validate()?;

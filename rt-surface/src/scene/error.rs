@@ -7,7 +7,7 @@ use rt_accel::BuildError;
 use super::ObjectKind;
 use crate::MaterialError;
 
-/// Why a [`SurfaceScene`] could not be built or changed.
+/// Why a [`SurfaceScene`](super::SurfaceScene) could not be built or changed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SceneError {
     /// Building or refitting a BVH failed (names the vertex or primitive,

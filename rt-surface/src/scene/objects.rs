@@ -59,7 +59,7 @@ pub struct Tube<'m> {
     pub material: Material,
 }
 
-/// The kinds of object in a [`SurfaceScene`], for naming one in an error.
+/// The kinds of object in a [`SurfaceScene`](super::SurfaceScene), for naming one in an error.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ObjectKind {
     /// A triangle mesh.

@@ -29,7 +29,7 @@ fn write(film: &Film, scale: f32, path: &Path) -> Result<(), String> {
     for (p, v) in frame.pixels_mut().iter_mut().zip(film.normalized()) {
         *p = Pixel { color: [v[0] * scale, v[1] * scale, v[2] * scale, 1.0], depth: 0.0 };
     }
-    write_png(&frame, path)
+    Ok(write_png(&frame, path)?)
 }
 
 pub(crate) fn render_all(out: &Path) -> Result<(), String> {
