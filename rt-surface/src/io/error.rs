@@ -1,6 +1,10 @@
 //! Why a file could not be read as a mesh.
 
-use alloc::{boxed::Box, string::String, vec::Vec};
+use alloc::{
+    boxed::Box,
+    string::{String, ToString},
+    vec::Vec,
+};
 use core::{error::Error, fmt};
 use std::path::{Path, PathBuf};
 
@@ -108,7 +112,11 @@ impl fmt::Display for ReadErrorKind {
                 f.write_str("unknown mesh format (expected .obj, .ply, .vtk or .vtp)")
             }
             Self::Malformed { message, source: Some(e) } => {
-                write!(f, "malformed mesh file: {message}: {e}")
+                // One line: parsers' messages may go on with dumps of their
+                // state, which `source()` still gives in full.
+                let text = e.to_string();
+                let first = text.lines().next().unwrap_or_default();
+                write!(f, "malformed mesh file: {message}: {first}")
             }
             Self::Malformed { message, source: None } => {
                 write!(f, "malformed mesh file: {message}")

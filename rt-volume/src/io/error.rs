@@ -1,6 +1,9 @@
 //! Why a file could not be read as a grid.
 
-use alloc::{boxed::Box, string::String};
+use alloc::{
+    boxed::Box,
+    string::{String, ToString},
+};
 use core::{error::Error, fmt};
 use std::path::{Path, PathBuf};
 
@@ -102,7 +105,11 @@ impl fmt::Display for ReadErrorKind {
                 "unknown grid format (expected .nrrd, .nhdr, .json with .raw, .vtk or .vti)",
             ),
             Self::Malformed { message, source: Some(e) } => {
-                write!(f, "malformed header: {message}: {e}")
+                // One line: parsers' messages may go on with dumps of their
+                // state, which `source()` still gives in full.
+                let text = e.to_string();
+                let first = text.lines().next().unwrap_or_default();
+                write!(f, "malformed header: {message}: {first}")
             }
             Self::Malformed { message, source: None } => write!(f, "malformed header: {message}"),
             Self::Unsupported(m) => write!(f, "unsupported: {m}"),
