@@ -63,6 +63,29 @@ fn film_accounts_for_every_photon() {
     }
 }
 
+/// Found by the `film` fuzz target (the target's own reference sum was at
+/// fault): weights of ±4.59e27 splatted at one point cancel exactly in
+/// the film's pixels, leaving the small weights landed between them
+/// intact where the footprints do not overlap (box and tent), while a
+/// plain running sum of the weights loses them. (Where footprints overlap,
+/// a pixel holds ±4.59e27 plus the small share, which f64 rounds away:
+/// the film, like any sum, is exact to `ε·Σ|w|`, as the target now
+/// checks.)
+#[test]
+fn fuzz_regression_cancelling_huge_weights_keep_the_small_ones() {
+    let huge = f32::from_bits(0x6d6d_6d6d); // 4.59e27, from the fuzz input
+    for filter in [Filter::Box, Filter::Tent] {
+        let mut film = Film::new(27, 40, filter).unwrap();
+        film.splat(2.8125, 0.0, [-huge; 3], (-1.375, 1.375));
+        film.splat(0.25, 3.875, [2.8125; 3], (2.8125, -2.8125));
+        film.splat(2.8125, 0.0, [huge; 3], (-1.375, 1.375));
+        film.splat(0.25, 3.875, [3.875; 3], (2.6875, -2.6875));
+        assert_eq!(film.total(), [6.6875; 3], "{filter:?}");
+        let naive = [-huge, 2.8125, huge, 3.875].iter().map(|&w| f64::from(w)).sum::<f64>();
+        assert_eq!(naive, 3.875, "the reference sum the fuzz target used loses 2.8125");
+    }
+}
+
 /// Every cutoff, for deflections swept log-uniformly over 1e-8 … 1e8 in
 /// both signs and both image axes (and NaN, ±∞): transmission stays in
 /// `[0, 1]`; a knife edge and a graded filter never darken as the
