@@ -5,16 +5,10 @@
 //!
 //! ```text
 //! # ranks as threads of one process (no MPI needed)
-//! cargo run --release -p rt-benches --example distributed -- [options]
+//! rt distributed --ranks 4 --schedule binary-swap
 //! # ranks as MPI processes (Debian: libopenmpi-dev openmpi-bin libclang-dev)
-//! cargo build --release -p rt-benches --features mpi --example distributed
-//! mpirun -np 4 target/release/examples/distributed [options]
-//!
-//!   --ranks N          ranks as threads (default 4; ignored under MPI)
-//!   --size WxH         image size (default 640x480)
-//!   --grid N           terrain of N×N vertices (default 257)
-//!   --schedule S       direct-send, binary-swap (default) or radix-K
-//!   --out PATH         PNG to write (default target/distributed.png)
+//! cargo build --release -p rt-cli --features mpi
+//! mpirun -np 4 target/release/rt distributed --schedule radix-3
 //! ```
 //!
 //! The mesh is cut into `N` slabs of triangles by centroid along its
@@ -25,92 +19,62 @@
 //! the same triangles with the same arithmetic: the composite must equal
 //! the whole-mesh render bit for bit, depth and colour. The program exits
 //! non-zero if one bit differs.
-#![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
-use std::{path::PathBuf, process::ExitCode, time::Instant};
+use std::{path::PathBuf, time::Instant};
 
-use glam::Vec3;
-
-use rt_benches::{image::write_png, scenes};
+use anyhow::{Context, anyhow, bail};
 use rt_composite::{Communicator, Mode, Schedule, composite};
-use rt_core::{Camera, ColorMap, Frame, Pixel, Projection};
+use rt_core::{Camera, ColorMap, Frame, Pixel, Projection, glam::Vec3};
 use rt_surface::{Light, Mesh, Paint, Renderer, Settings, SurfaceScene};
 
-const USAGE: &str = "usage: distributed [--ranks N] [--size WxH] [--grid N] \
-[--schedule direct-send|binary-swap|radix-K] [--out PATH]";
+use crate::{image::write_png, parse, scenes};
 
-struct Options {
-    ranks: usize,
-    size: (u32, u32),
-    grid: u32,
-    schedule: Schedule,
-    out: PathBuf,
+/// A compositing schedule: `direct-send`, `binary-swap` or `radix-K`.
+fn schedule(s: &str) -> Result<Schedule, String> {
+    match s {
+        "direct-send" => Ok(Schedule::DirectSend),
+        "binary-swap" => Ok(Schedule::BinarySwap),
+        _ => match s.strip_prefix("radix-").map(str::parse::<usize>) {
+            Some(Ok(k)) if k >= 2 => Ok(Schedule::RadixK(k)),
+            _ => Err(format!("`{s}`: direct-send, binary-swap or radix-K with K ≥ 2")),
+        },
+    }
 }
 
-fn parse_args(args: impl Iterator<Item = String>) -> Result<Options, String> {
-    let mut o = Options {
-        ranks: 4,
-        size: (640, 480),
-        grid: 257,
-        schedule: Schedule::BinarySwap,
-        out: PathBuf::from("target/distributed.png"),
-    };
-    let mut args = args;
-    while let Some(a) = args.next() {
-        let mut value = || args.next().ok_or_else(|| format!("{a} needs a value"));
-        match a.as_str() {
-            "--ranks" => {
-                o.ranks = value()?.parse().map_err(|_| "--ranks: not a count")?;
-                if !(1..=256).contains(&o.ranks) {
-                    return Err("--ranks: 1 to 256".into());
-                }
-            }
-            "--size" => {
-                let v = value()?;
-                let (w, h) = v.split_once('x').ok_or("--size: WxH")?;
-                o.size = (
-                    w.parse().map_err(|_| "--size: bad width")?,
-                    h.parse().map_err(|_| "--size: bad height")?,
-                );
-            }
-            "--grid" => {
-                o.grid = value()?.parse().map_err(|_| "--grid: not a count")?;
-                if !(2..=4097).contains(&o.grid) {
-                    return Err("--grid: 2 to 4097".into());
-                }
-            }
-            "--schedule" => {
-                let v = value()?;
-                o.schedule = match v.as_str() {
-                    "direct-send" => Schedule::DirectSend,
-                    "binary-swap" => Schedule::BinarySwap,
-                    s => match s.strip_prefix("radix-").map(str::parse) {
-                        Some(Ok(k)) => Schedule::RadixK(k),
-                        _ => return Err(format!("--schedule: unknown `{v}`")),
-                    },
-                };
-            }
-            "--out" => o.out = PathBuf::from(value()?),
-            "-h" | "--help" => return Err(USAGE.into()),
-            other => return Err(format!("unknown option `{other}`\n{USAGE}")),
-        }
-    }
-    Ok(o)
+/// `rt distributed`: options.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Ranks, as threads of this process (ignored under MPI, where
+    /// `mpirun -np N` sets them).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub ranks: u32,
+    /// Image size in pixels, WxH.
+    #[arg(long, value_parser = parse::size, default_value = "640x480")]
+    pub size: (u32, u32),
+    /// The terrain has N×N vertices (2 (N−1)² triangles).
+    #[arg(long, default_value_t = 257, value_parser = clap::value_parser!(u32).range(2..=4096))]
+    pub grid: u32,
+    /// Compositing schedule: direct-send, binary-swap or radix-K (K ≥ 2).
+    #[arg(long, value_parser = schedule, default_value = "binary-swap")]
+    pub schedule: Schedule,
+    /// PNG rank 0 writes.
+    #[arg(long, default_value = "out/distributed.png")]
+    pub out: PathBuf,
 }
 
 /// The whole terrain, coloured by height, and the colour map's range.
-fn terrain(grid: u32) -> Result<(Mesh, (f32, f32)), String> {
+fn terrain(grid: u32) -> anyhow::Result<(Mesh, (f32, f32))> {
     let t = scenes::terrain(grid);
-    let heights: Vec<f32> = t.positions.iter().map(|p| p.y).collect();
+    let heights: Vec<f32> = t.positions().iter().map(|p| p.y).collect();
     let range = heights.iter().fold((f32::MAX, f32::MIN), |(a, b), &h| (a.min(h), b.max(h)));
-    let mesh = Mesh::new(t.positions, t.indices, Some(heights)).map_err(|e| e.to_string())?;
+    let mesh = Mesh::from(t).with_scalars(heights)?;
     Ok((mesh, range))
 }
 
 /// Slab `rank` of `ranks`: the triangles whose centroids fall in that
 /// share of the order along the mesh's longest axis, with only the
 /// vertices they use (values copied, so shading is unchanged).
-fn share(mesh: &Mesh, rank: usize, ranks: usize) -> Result<Mesh, String> {
+fn share(mesh: &Mesh, rank: usize, ranks: usize) -> anyhow::Result<Mesh> {
     let (p, idx) = (mesh.positions(), mesh.indices());
     let (lo, hi) = p.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
     let axis = (hi - lo).max_position();
@@ -132,14 +96,13 @@ fn share(mesh: &Mesh, rank: usize, ranks: usize) -> Result<Mesh, String> {
             remap[v]
         }));
     }
-    Mesh::new(positions, indices, Some(scalars)).map_err(|e| e.to_string())
+    Ok(Mesh::new(positions, indices, Some(scalars))?)
 }
 
 /// One sample at each pixel centre of `mesh`, lit locally.
-fn render(mesh: Mesh, range: (f32, f32), size: (u32, u32)) -> Result<Frame, String> {
-    let paint =
-        Paint::Mapped(ColorMap::viridis().with_range(range.0, range.1).map_err(|e| e.to_string())?);
-    let world = SurfaceScene::from_mesh(mesh, paint).map_err(|e| e.to_string())?;
+fn render(mesh: Mesh, range: (f32, f32), size: (u32, u32)) -> anyhow::Result<Frame> {
+    let paint = Paint::Mapped(ColorMap::viridis().with_range(range.0, range.1)?);
+    let world = SurfaceScene::from_mesh(mesh, paint)?;
     let cam = Camera::look_at(
         Vec3::new(1.5, 1.3, 2.1),
         Vec3::new(0.0, 0.1, 0.0),
@@ -147,8 +110,7 @@ fn render(mesh: Mesh, range: (f32, f32), size: (u32, u32)) -> Result<Frame, Stri
         Projection::Perspective { fov_y: 40f32.to_radians() },
         size.0,
         size.1,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let settings = Settings {
         lights: vec![
             Light::Ambient { color: [0.35; 3] },
@@ -158,13 +120,13 @@ fn render(mesh: Mesh, range: (f32, f32), size: (u32, u32)) -> Result<Frame, Stri
         ao_samples: 0,
         ..Settings::default()
     };
-    let mut renderer = Renderer::new(cam, settings).map_err(|e| e.to_string())?;
+    let mut renderer = Renderer::new(cam, settings)?;
     renderer.render_pass(&world);
-    renderer.frame().map_err(|e| e.to_string())
+    Ok(renderer.frame()?)
 }
 
 /// What one rank does: render its share, composite; rank 0 gets the image.
-fn rank_main<C: Communicator>(comm: &C, o: &Options) -> Result<Option<Frame>, String> {
+fn rank_main<C: Communicator>(comm: &C, o: &Args) -> anyhow::Result<Option<Frame>> {
     let (rank, ranks) = (comm.rank(), comm.size());
     let (mesh, range) = terrain(o.grid)?;
     let mine = share(&mesh, rank, ranks)?;
@@ -177,7 +139,7 @@ fn rank_main<C: Communicator>(comm: &C, o: &Options) -> Result<Option<Frame>, St
     let t1 = Instant::now();
     let (image, stats) =
         composite(comm, frame.pixels(), o.size.0, o.size.1, o.schedule, &Mode::Depth)
-            .map_err(|e| format!("rank {rank}: {e}"))?;
+            .with_context(|| format!("rank {rank}"))?;
     println!(
         "rank {rank}/{ranks}: {triangles} triangles, {active} pixels covered, render {rendered:.3} s, \
          composite {:.3} s, sent {} bytes in {} messages",
@@ -186,13 +148,13 @@ fn rank_main<C: Communicator>(comm: &C, o: &Options) -> Result<Option<Frame>, St
         stats.messages,
     );
     let Some(pixels) = image else { return Ok(None) };
-    let mut out = Frame::new(o.size.0, o.size.1).map_err(|e| e.to_string())?;
+    let mut out = Frame::new(o.size.0, o.size.1)?;
     out.pixels_mut().copy_from_slice(&pixels);
     Ok(Some(out))
 }
 
 /// Rank 0's check against the whole mesh rendered in one process.
-fn check(composited: &Frame, o: &Options) -> Result<(), String> {
+fn check(composited: &Frame, o: &Args) -> anyhow::Result<()> {
     write_png(composited, &o.out)?;
     let (mesh, range) = terrain(o.grid)?;
     let whole = render(mesh, range, o.size)?;
@@ -207,15 +169,24 @@ fn check(composited: &Frame, o: &Options) -> Result<(), String> {
         o.size.1
     );
     if covered == 0 {
-        return Err("nothing in view".into());
+        bail!("nothing in view");
     }
-    if differ == 0 { Ok(()) } else { Err(format!("{differ} pixels differ")) }
+    if differ > 0 {
+        bail!("{differ} pixels differ from the single-process render");
+    }
+    Ok(())
 }
 
+/// Runs `rt distributed` on MPI processes.
+///
+/// # Errors
+/// A failing rank (every rank learns of it), or a composite that differs
+/// from the single-process render.
 #[cfg(feature = "mpi")]
-fn run(o: &Options) -> Result<(), String> {
+pub fn run(o: &Args) -> anyhow::Result<()> {
     use rt_composite::{MpiComm, mpi::traits::Communicator as _};
-    let universe = rt_composite::mpi::initialize().ok_or("MPI was already initialised")?;
+    let universe =
+        rt_composite::mpi::initialize().ok_or_else(|| anyhow!("MPI was already initialised"))?;
     let world = universe.world();
     let comm = MpiComm::new(&world, std::time::Duration::from_secs(60));
     let result = rank_main(&comm, o).and_then(|f| f.map_or(Ok(()), |f| check(&f, o)));
@@ -224,21 +195,26 @@ fn run(o: &Options) -> Result<(), String> {
     rt_composite::mpi::traits::Root::broadcast_into(&world.process_at_rank(0), &mut ok);
     match result {
         Err(e) => Err(e),
-        Ok(()) if ok == 0 => Err("rank 0 failed".into()),
+        Ok(()) if ok == 0 => Err(anyhow!("rank 0 failed")),
         Ok(()) => Ok(()),
     }
 }
 
+/// Runs `rt distributed` on threads.
+///
+/// # Errors
+/// A failing rank, or a composite that differs from the single-process
+/// render.
 #[cfg(not(feature = "mpi"))]
-fn run(o: &Options) -> Result<(), String> {
+pub fn run(o: &Args) -> anyhow::Result<()> {
     use rt_composite::ThreadComm;
-    let comms = ThreadComm::group(o.ranks, std::time::Duration::from_secs(60));
-    let results: Vec<Result<Option<Frame>, String>> = std::thread::scope(|s| {
+    let comms = ThreadComm::group(o.ranks as usize, std::time::Duration::from_secs(60));
+    let results: Vec<anyhow::Result<Option<Frame>>> = std::thread::scope(|s| {
         let handles: Vec<_> =
             comms.into_iter().map(|c| s.spawn(move || rank_main(&c, o))).collect();
         handles
             .into_iter()
-            .map(|h| h.join().unwrap_or_else(|_| Err("a rank panicked".into())))
+            .map(|h| h.join().unwrap_or_else(|_| Err(anyhow!("a rank panicked"))))
             .collect()
     });
     let mut image = None;
@@ -247,16 +223,5 @@ fn run(o: &Options) -> Result<(), String> {
             image = Some(f);
         }
     }
-    check(&image.ok_or("no rank returned the image")?, o)
-}
-
-fn main() -> ExitCode {
-    let result = parse_args(std::env::args().skip(1)).and_then(|o| run(&o));
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("distributed: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    check(&image.ok_or_else(|| anyhow!("no rank returned the image"))?, o)
 }

@@ -1,7 +1,7 @@
-//! The main job: renders the built-in scenes and writes PNGs.
+//! `rt demo`: the main job — renders the built-in scenes into a folder.
 //!
 //! ```text
-//! cargo run --release -p rt-benches --bin rt-demo -- [OUT_DIR]   (default: out/)
+//! rt demo [DIR]          (default: out/)
 //! ```
 //!
 //! Writes, 8-bit sRGB PNGs:
@@ -13,27 +13,33 @@
 //!   with ambient occlusion (8 rays) and a directional light with hard
 //!   shadows; 4 progressive passes.
 //! - `terrain.ply`: the terrain mesh with its `height` scalar, to try the
-//!   `view` example on (`--scalar height`).
-//! - From the built-in blast wave (`benches/data/`, a real PyClaw Euler
+//!   `rt view` on (`--scalar height`).
+//! - From the built-in blast wave (`rt-cli/data/`, a real PyClaw Euler
 //!   solution, density → index by Gladstone–Dale), photons traced through
 //!   the volume along z: `schlieren-knife.png` (vertical knife edge,
 //!   background mid-grey), `shadowgraph.png` (film 2 m behind, background
 //!   mid-grey), `interferogram.png` (10.6 µm CO₂ laser, finite fringes) and
 //!   `schlieren-color.png` (hue-wheel colour filter: hue = direction of
 //!   deflection, saturation = its size).
-// A std-only tool crate: the no_std import lints guard the libraries.
-#![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
+mod optics;
 
-mod schlieren;
+use std::{path::PathBuf, time::Instant};
 
-use std::{path::PathBuf, process::ExitCode, time::Instant};
-
-use glam::Vec3;
-use rt_benches::{image::write_png, scenes};
-use rt_core::{Camera, ColorMap, Projection, intersect::Sphere};
+use anyhow::Context;
+use rt_core::{Camera, ColorMap, Projection, glam::Vec3, intersect::Sphere};
 use rt_surface::{
     Glyphs, Light, Material, Mesh, Paint, Renderer, Settings, SurfaceScene, Tube, io::write_ply,
 };
+
+use crate::{image::write_png, scenes};
+
+/// `rt demo [DIR]`: options.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Folder to write the pictures into (created if missing).
+    #[arg(default_value = "out")]
+    pub dir: PathBuf,
+}
 
 const WIDTH: u32 = 960;
 const HEIGHT: u32 = 640;
@@ -41,13 +47,13 @@ const HEIGHT: u32 = 640;
 const PASSES: u32 = 4;
 
 /// The terrain coloured by its height.
-fn terrain() -> Result<Mesh, String> {
+fn terrain() -> anyhow::Result<Mesh> {
     let terrain = scenes::terrain(257);
-    let heights: Vec<f32> = terrain.positions.iter().map(|p| p.y).collect();
-    Mesh::new(terrain.positions, terrain.indices, Some(heights)).map_err(|e| e.to_string())
+    let heights: Vec<f32> = terrain.positions().iter().map(|p| p.y).collect();
+    Ok(Mesh::from(terrain).with_scalars(heights)?)
 }
 
-fn build_world(mesh: Mesh) -> Result<SurfaceScene<'static>, String> {
+fn build_world(mesh: Mesh) -> anyhow::Result<SurfaceScene<'static>> {
     let heights = mesh.scalars().unwrap_or_default();
     let (lo, hi) = heights.iter().fold((f32::MAX, f32::MIN), |(a, b), &h| (a.min(h), b.max(h)));
     // A ring of glyphs above the terrain, sized and coloured by a scalar.
@@ -77,39 +83,30 @@ fn build_world(mesh: Mesh) -> Result<SurfaceScene<'static>, String> {
     let glyphs = Glyphs {
         spheres,
         scalars: Some(radii),
-        paint: Paint::Mapped(
-            ColorMap::cool_to_warm().with_range(0.03, 0.06).map_err(|e| e.to_string())?,
-        ),
+        paint: Paint::Mapped(ColorMap::cool_to_warm().with_range(0.03, 0.06)?),
         material: Material { mirror: 0.25, ..Material::GLOSSY },
     };
-    let height = Paint::Mapped(ColorMap::viridis().with_range(lo, hi).map_err(|e| e.to_string())?);
-    SurfaceScene::builder()
+    let height = Paint::Mapped(ColorMap::viridis().with_range(lo, hi)?);
+    Ok(SurfaceScene::builder()
         .mesh(mesh, height, Material::MATTE)
         .glyphs(glyphs)
         .tube(tube)
-        .build()
-        .map_err(|e| e.to_string())
+        .build()?)
 }
 
-fn main() -> ExitCode {
-    let out = std::env::args().nth(1).map_or_else(|| PathBuf::from("out"), PathBuf::from);
-    match run(&out) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("rt-demo: {e}");
-            ExitCode::FAILURE
-        }
-    }
-}
-
-fn run(out: &std::path::Path) -> Result<(), String> {
-    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+/// Runs `rt demo`.
+///
+/// # Errors
+/// An unwritable folder or file.
+pub fn run(a: &Args) -> anyhow::Result<()> {
+    let out = a.dir.as_path();
+    std::fs::create_dir_all(out).with_context(|| out.display().to_string())?;
     let mesh = terrain()?;
-    // The terrain as a file, to try the `view` example on.
+    // The terrain as a file, to try `rt view` on.
     let ply = out.join("terrain.ply");
-    let file = std::fs::File::create(&ply).map_err(|e| format!("{}: {e}", ply.display()))?;
+    let file = std::fs::File::create(&ply).with_context(|| ply.display().to_string())?;
     write_ply(&mesh, "height", std::io::BufWriter::new(file))
-        .map_err(|e| format!("{}: {e}", ply.display()))?;
+        .with_context(|| ply.display().to_string())?;
     let t0 = Instant::now();
     let world = build_world(mesh)?;
     let built = t0.elapsed();
@@ -121,8 +118,7 @@ fn run(out: &std::path::Path) -> Result<(), String> {
         proj,
         WIDTH,
         HEIGHT,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let settings = Settings {
         lights: vec![
             Light::Ambient { color: [0.35; 3] },
@@ -133,14 +129,14 @@ fn run(out: &std::path::Path) -> Result<(), String> {
         ao_distance: 0.25,
         ..Settings::default()
     };
-    let mut renderer = Renderer::new(cam, settings).map_err(|e| e.to_string())?;
+    let mut renderer = Renderer::new(cam, settings)?;
     let t1 = Instant::now();
     // Tiles on all cores (rayon); the frame is identical at any thread count.
     for _ in 0..PASSES {
         renderer.render_pass(&world);
     }
     let rendered = t1.elapsed();
-    let frame = renderer.frame().map_err(|e| e.to_string())?;
+    let frame = renderer.frame()?;
     let c = renderer.counts();
     let path = out.join("surface.png");
     write_png(&frame, &path)?;
@@ -155,5 +151,5 @@ fn run(out: &std::path::Path) -> Result<(), String> {
         c.ao,
         c.reflection,
     );
-    schlieren::render_all(out)
+    optics::render_all(out)
 }

@@ -1,0 +1,130 @@
+//! `rt info`: what a volume or mesh file holds.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use rt_photo::{Cutoff, Mode};
+use rt_surface::io::{MeshData, read_mesh};
+use rt_volume::{GLADSTONE_DALE_AIR, Grid, io::read_grid};
+
+use crate::{
+    optics::{Axis, Interpolation, Quantity, Volume},
+    parse,
+};
+
+/// `rt info FILE`: options.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// A volume (.nrrd, .nhdr, .json, .raw, .vtk, .vti) or a mesh (.obj,
+    /// .ply, .vtk, .vtp).
+    pub file: PathBuf,
+    /// For volumes: what the samples are (for the deflection survey).
+    #[arg(long, value_enum, default_value_t = Quantity::Density)]
+    pub quantity: Quantity,
+    /// Gladstone–Dale constant K in m³/kg.
+    #[arg(long, default_value_t = GLADSTONE_DALE_AIR, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub k: f64,
+    /// For volumes: the beam direction of the deflection survey.
+    #[arg(long, value_enum, default_value_t = Axis::Z)]
+    pub axis: Axis,
+}
+
+/// Runs `rt info`.
+///
+/// # Errors
+/// A file that is neither a readable volume nor a readable mesh.
+pub fn run(a: &Args) -> anyhow::Result<()> {
+    let ext = a.file.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let text = match ext.as_deref() {
+        Some("obj" | "ply" | "vtp") => mesh(&a.file, &read_mesh(&a.file)?),
+        // Legacy VTK holds either: try image data, then polydata.
+        Some("vtk") => match read_grid(&a.file) {
+            Ok(g) => volume(a, &g)?,
+            Err(grid_error) => match read_mesh(&a.file) {
+                Ok(m) => mesh(&a.file, &m),
+                Err(_) => return Err(grid_error.into()),
+            },
+        },
+        _ => volume(a, &read_grid(&a.file)?)?,
+    };
+    print!("{text}");
+    Ok(())
+}
+
+/// `lo … hi` of the finite values, with the count of others.
+fn range(values: impl Iterator<Item = f64>) -> String {
+    let (mut lo, mut hi, mut sum, mut n, mut bad) = (f64::MAX, f64::MIN, 0.0, 0usize, 0usize);
+    for v in values {
+        if v.is_finite() {
+            (lo, hi, sum, n) = (lo.min(v), hi.max(v), sum + v, n + 1);
+        } else {
+            bad += 1;
+        }
+    }
+    if n == 0 {
+        return format!("no finite values ({bad} others)");
+    }
+    let mean = sum / n as f64;
+    let others = if bad > 0 { format!(", {bad} not finite") } else { String::new() };
+    format!("{lo} … {hi} (mean {mean:.6}{others})")
+}
+
+fn volume(a: &Args, g: &Grid) -> anyhow::Result<String> {
+    let [nx, ny, nz] = g.dims();
+    let (o, s, b) = (g.origin(), g.spacing(), g.bounds());
+    let mut text = format!(
+        "{}: volume of {nx}×{ny}×{nz} samples, cell-centred\n\
+         spacing {} × {} × {}, first sample at ({}, {}, {})\n\
+         bounds ({}, {}, {}) … ({}, {}, {})\n\
+         values {}\n",
+        a.file.display(),
+        s.x,
+        s.y,
+        s.z,
+        o.x,
+        o.y,
+        o.z,
+        b.min.x,
+        b.min.y,
+        b.min.z,
+        b.max.x,
+        b.max.y,
+        b.max.z,
+        range(g.data().iter().map(|&v| f64::from(v))),
+    );
+    let v = Volume::new(g.clone(), a.quantity, a.k, true, Interpolation::Linear)
+        .context("preparing the deflection survey")?;
+    text += &format!("index {}\n", range(v.field.grid().data().iter().map(|&n| f64::from(n))));
+    let bench = v.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
+    let survey = v.survey(&bench)?;
+    text += &format!(
+        "deflection along {} (one photon per pixel of a {}-wide survey): |ε| median {:.3e}, 99th percentile {:.3e}, max {:.3e} rad\n",
+        format!("{:?}", a.axis).to_lowercase(),
+        survey.width,
+        survey.magnitude(0.5),
+        survey.magnitude(0.99),
+        survey.magnitude(1.0),
+    );
+    Ok(text)
+}
+
+fn mesh(path: &Path, m: &MeshData) -> String {
+    let coord = |k: usize| range(m.positions.iter().map(move |p| f64::from(p[k])));
+    let mut text = format!(
+        "{}: mesh of {} vertices, {} triangles\nx {}\ny {}\nz {}\nnormals: {}\n",
+        path.display(),
+        m.positions.len(),
+        m.indices.len(),
+        coord(0),
+        coord(1),
+        coord(2),
+        if m.normals.is_some() { "one per vertex" } else { "none" },
+    );
+    if m.scalars.is_empty() {
+        text += "scalars: none\n";
+    }
+    for (name, values) in &m.scalars {
+        text += &format!("scalar {name}: {}\n", range(values.iter().map(|&v| f64::from(v))));
+    }
+    text
+}

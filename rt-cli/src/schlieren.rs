@@ -1,0 +1,242 @@
+//! `rt schlieren`: synthetic schlieren, shadowgraph, interferogram or
+//! colour schlieren of a volume file, with automatic exposure.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use clap::ValueEnum;
+use rt_photo::{Cutoff, Film, FilterImage, Mode};
+use rt_volume::{GLADSTONE_DALE_AIR, io::read_grid};
+
+use crate::{
+    image,
+    optics::{Axis, Interpolation, Quantity, Survey, Volume},
+    parse,
+};
+
+/// The optical set-up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum CutoffKind {
+    /// Knife edge across the `--angle` direction (classic schlieren).
+    Knife,
+    /// Graded filter: transmission ramps linearly with the deflection.
+    Graded,
+    /// Pinhole in the focal plane: passes only weakly deflected light.
+    Pinhole,
+    /// Opaque disc in the focal plane: passes only deflected light.
+    DarkField,
+    /// Hue-wheel colour filter: hue = direction of deflection, saturation
+    /// = its size (rainbow schlieren).
+    Color,
+    /// No cutoff: a shadowgraph (with a film distance) or plain
+    /// transmission.
+    None,
+    /// Interferometry: phase from the optical path, with optional finite
+    /// fringes.
+    Interferometry,
+}
+
+/// `rt schlieren FILE`: options.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The volume: NRRD (.nrrd/.nhdr), raw + JSON sidecar (.json/.raw) or
+    /// VTK image data (.vtk/.vti).
+    pub file: PathBuf,
+    /// What the samples are.
+    #[arg(long, value_enum, default_value_t = Quantity::Density)]
+    pub quantity: Quantity,
+    /// Gladstone–Dale constant K in m³/kg (n = 1 + K·ρ; air at 589 nm).
+    #[arg(long, default_value_t = GLADSTONE_DALE_AIR, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub k: f64,
+    /// Accept densities ≤ 0 (or indices below 1) instead of refusing them.
+    #[arg(long)]
+    pub allow_nonphysical: bool,
+    /// The optical set-up.
+    #[arg(long, value_enum, default_value_t = CutoffKind::Knife)]
+    pub cutoff: CutoffKind,
+    /// Direction the knife edge or graded filter is sensitive to, in
+    /// degrees from the image's horizontal axis.
+    #[arg(long, default_value_t = 0.0, value_parser = parse::finite, allow_hyphen_values = true)]
+    pub angle: f64,
+    /// Focal length of the schlieren head, in metres.
+    #[arg(long, default_value_t = 1.0, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub f: f64,
+    /// Source image height (knife edge) or ramp width (graded filter) in
+    /// metres [default: automatic, the 99th percentile of the deflection
+    /// maps to 0.45 of the range].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub h: Option<f64>,
+    /// Stop radius in the focal plane (pinhole, dark field), in metres
+    /// [default: automatic, a quarter of the 99th-percentile deflection
+    /// times f].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub radius: Option<f64>,
+    /// Colour filter half range: the deflection at the wheel's rim, in
+    /// radians [default: automatic, the 99th-percentile deflection].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub half_range: Option<f64>,
+    /// Interferometry wavelength in metres (CO₂ laser: 10.6e-6).
+    #[arg(long, default_value_t = 10.6e-6, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub lambda: f64,
+    /// Interferometry fringe spacing on the film in metres [default:
+    /// infinite fringe].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub fringes: Option<f64>,
+    /// Film distance behind the volume, in metres [default: automatic for
+    /// a shadowgraph (--cutoff none), the strongest contrast about 0.5; 0
+    /// otherwise].
+    #[arg(long, value_parser = parse::finite, allow_hyphen_values = true)]
+    pub film_distance: Option<f64>,
+    /// Beam direction.
+    #[arg(long, value_enum, default_value_t = Axis::Z)]
+    pub axis: Axis,
+    /// Image width in pixels (height follows the volume's aspect).
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=i64::from(parse::MAX_EDGE)))]
+    pub size: u32,
+    /// Photons per pixel (rounded up to a multiple of 4: 2×2 strata per
+    /// pass).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub photons: u32,
+    /// Interpolation between samples.
+    #[arg(long, value_enum, default_value_t = Interpolation::Linear)]
+    pub interp: Interpolation,
+    /// Seed of every random choice: the same seed gives the same image.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// PNG to write.
+    #[arg(long, default_value = "out/schlieren.png")]
+    pub out: PathBuf,
+}
+
+/// The most photons one run may trace.
+const MAX_PHOTONS: u64 = 1 << 36;
+
+/// The cutoff or mode for `args`, its parameters chosen from `survey` where
+/// the user left them out; returns a line saying what was chosen.
+fn optics(a: &Args, survey: &Survey, n_ref: f64) -> (Mode, f64, String) {
+    let angle = a.angle.to_radians();
+    // Knife edge and graded filter: 0.5 ± 0.45 at the 99th percentile.
+    let eps_perp = survey.along(angle, 0.99).max(1e-12);
+    let eps = survey.magnitude(0.99).max(1e-12);
+    let f = a.f;
+    let film = a.film_distance.unwrap_or(0.0);
+    match a.cutoff {
+        CutoffKind::Knife => {
+            let h = a.h.unwrap_or(f * eps_perp / 0.45);
+            let mode = Mode::Schlieren(Cutoff::KnifeEdge { angle, offset: 0.0, f, h });
+            (mode, film, format!("knife edge at {} deg, f = {f} m, h = {h:.4e} m", a.angle))
+        }
+        CutoffKind::Graded => {
+            let width = a.h.unwrap_or(f * eps_perp / 0.45);
+            let mode = Mode::Schlieren(Cutoff::Graded { angle, f, width });
+            (mode, film, format!("graded filter at {} deg, f = {f} m, h = {width:.4e} m", a.angle))
+        }
+        CutoffKind::Pinhole | CutoffKind::DarkField => {
+            let radius = a.radius.unwrap_or(0.25 * f * eps);
+            let dark_field = a.cutoff == CutoffKind::DarkField;
+            let mode = Mode::Schlieren(Cutoff::Pinhole { f, radius, dark_field });
+            let what = if dark_field { "dark-field stop" } else { "pinhole" };
+            (mode, film, format!("{what}, f = {f} m, radius = {radius:.4e} m"))
+        }
+        CutoffKind::Color => {
+            let half = a.half_range.unwrap_or(eps);
+            let mode = Mode::Schlieren(Cutoff::Color(FilterImage::hue_wheel(256, half)));
+            (mode, film, format!("colour filter, half range = {half:.4e} rad"))
+        }
+        CutoffKind::None => {
+            let div = survey.divergence(0.99);
+            let l = a.film_distance.unwrap_or(if div > 0.0 { 0.5 / div } else { 0.0 });
+            (Mode::Schlieren(Cutoff::None), l, format!("no cutoff, film distance = {l:.4} m"))
+        }
+        CutoffKind::Interferometry => {
+            let mode = Mode::Interferometry { lambda: a.lambda, n_ref, fringe_spacing: a.fringes };
+            let fringes =
+                a.fringes.map_or("infinite fringe".to_string(), |s| format!("fringes {s} m"));
+            (mode, film, format!("interferometry, λ = {} m, n_ref = {n_ref}, {fringes}", a.lambda))
+        }
+    }
+}
+
+/// Runs `rt schlieren`.
+///
+/// # Errors
+/// An unreadable or unsuitable volume, bad optics, too many photons, an
+/// unwritable output.
+pub fn run(a: &Args) -> anyhow::Result<()> {
+    let grid = read_grid(&a.file)?;
+    let volume = Volume::new(grid, a.quantity, a.k, a.allow_nonphysical, a.interp)
+        .with_context(|| a.file.display().to_string())?;
+    render(&volume, a)
+}
+
+/// Renders `volume` as `a` says (its file and sample options aside) and
+/// writes the PNG; prints one summary line.
+///
+/// # Errors
+/// Bad optics, too many photons, an unwritable output.
+pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
+    let probe = volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
+    let height = ((f64::from(a.size)) * probe.height / probe.width).round().max(1.0);
+    let photons = u64::from(a.size) * height as u64 * u64::from(a.photons.next_multiple_of(4));
+    if photons > MAX_PHOTONS {
+        bail!(
+            "{photons} photons is more than one run traces ({MAX_PHOTONS}); lower --size or --photons"
+        );
+    }
+    let survey = volume.survey(&probe)?;
+    let n_ref = volume.field.grid().data().first().map_or(1.0, |&n| f64::from(n));
+    let (mode, film_distance, chosen) = optics(a, &survey, n_ref);
+    if let Mode::Interferometry { lambda, fringe_spacing, .. } = mode {
+        // Phase step per pixel: the deflection is the phase gradient over k.
+        let pixel = probe.width / f64::from(a.size);
+        let tau = std::f64::consts::TAU;
+        let step = tau / lambda * survey.magnitude(0.99) * pixel
+            + fringe_spacing.map_or(0.0, |s| tau * pixel / s);
+        if step > std::f64::consts::PI {
+            eprintln!(
+                "rt: warning: fringes alias: up to {step:.1} rad of phase per pixel (> π); raise --size or --lambda"
+            );
+        }
+    }
+    let bench = volume.bench(a.axis, mode, film_distance);
+    let (film, seconds) = volume.render(&bench, a.size as usize, a.photons, a.seed)?;
+    let scale = if matches!(bench.mode, Mode::Schlieren(Cutoff::None)) { 0.5 } else { 1.0 };
+    image::write_film(&film, scale, &a.out)?;
+    println!("{}", summary(&a.out, &film, seconds, &chosen));
+    Ok(())
+}
+
+impl Args {
+    /// The options `rt schlieren FILE ARGS…` would parse to, defaults
+    /// included.
+    ///
+    /// # Errors
+    /// What clap reports for bad arguments.
+    pub fn from_args<I, T>(file: &std::path::Path, args: I) -> Result<Self, clap::Error>
+    where
+        I: IntoIterator<Item = T>,
+        T: Into<std::ffi::OsString> + Clone,
+    {
+        #[derive(clap::Parser)]
+        struct Wrap {
+            #[command(flatten)]
+            args: Args,
+        }
+        let argv = ["schlieren".into(), file.as_os_str().to_owned()]
+            .into_iter()
+            .chain(args.into_iter().map(Into::into));
+        <Wrap as clap::Parser>::try_parse_from(argv).map(|w| w.args)
+    }
+}
+
+/// One line: what was written, how many photons in how long, the optics.
+pub(crate) fn summary(out: &std::path::Path, film: &Film, seconds: f64, chosen: &str) -> String {
+    format!(
+        "wrote {} ({}×{}, {} photons in {seconds:.2} s, {:.2} M photons/s; {chosen})",
+        out.display(),
+        film.width(),
+        film.height(),
+        film.emitted,
+        film.emitted as f64 / seconds.max(1e-9) / 1e6,
+    )
+}
