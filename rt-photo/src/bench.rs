@@ -7,8 +7,8 @@ use glam::DVec3;
 use rt_core::ColorMap;
 use rt_core::sampling::{rng_for, uniform};
 use rt_volume::{
-    BeamMask, BeamWindow, GridField, IndexField, Interp, Octree, TraceError, TraceParams,
-    TraceResult, trace, trace_beam, trace_visiting,
+    BeamMask, BeamWindow, GridField, IndexField, Octree, TraceError, TraceParams, TraceResult,
+    trace, trace_beam, trace_visiting,
 };
 
 use crate::{Cutoff, CutoffError, Film, Photon, math};
@@ -304,8 +304,10 @@ impl Bench {
     /// bench cannot resolve ([`Bench::skip_tolerance`]); photons whose line
     /// meets no node too rough for it (a [`BeamMask`] with one cell per
     /// film pixel) go straight without walking the tree. Pair it with
-    /// [`TraceParams::for_grid`]. Fields interpolated other than
-    /// trilinearly are traced without skipping.
+    /// [`TraceParams::for_grid`]. The tree must bound the field's own
+    /// interpolant (trilinear or Catmull–Rom: [`rt_volume::build_octree`]
+    /// builds it so); with a tree built for another, the field is traced
+    /// without skipping.
     ///
     /// # Errors
     /// As [`Bench::render`].
@@ -317,7 +319,7 @@ impl Bench {
         pass: u64,
         seed: u64,
     ) -> Result<(), BenchError> {
-        if field.interp() != Interp::Trilinear {
+        if field.interp() != tree.interp() {
             return self.render(field, film, pass, seed);
         }
         self.validate()?;

@@ -7,7 +7,10 @@ use std::path::Path;
 use anyhow::Context;
 use rt_volume::io;
 
-use crate::{optics::Volume, schlieren};
+use crate::{
+    optics::{Interpolation, Volume},
+    schlieren,
+};
 
 const RAW: &[u8] = include_bytes!("../../data/blast_sedov_64.raw");
 const JSON: &str = include_str!("../../data/blast_sedov_64.json");
@@ -15,7 +18,8 @@ const JSON: &str = include_str!("../../data/blast_sedov_64.json");
 /// The blast wave's density, as index by Gladstone–Dale.
 fn blast_wave() -> anyhow::Result<Volume> {
     let header: serde_json::Value = serde_json::from_str(JSON).context("built-in JSON header")?;
-    Volume::density(io::parse_raw_json(&header, RAW).context("built-in blast wave")?)
+    let grid = io::parse_raw_json(&header, RAW).context("built-in blast wave")?;
+    Volume::density(grid, Interpolation::Cubic)
 }
 
 /// Renders the four optical pictures into `out`.

@@ -7,7 +7,7 @@ use glam::DVec3;
 
 use super::{Octree, trace_skipping};
 use crate::{
-    Bounds, Exit, GridField, IndexField, Interp, TraceError, TraceParams, TraceResult, TraceStats,
+    Bounds, Exit, GridField, IndexField, TraceError, TraceParams, TraceResult, TraceStats,
     trace::check_params,
 };
 
@@ -66,7 +66,8 @@ impl BeamMask {
     ///
     /// # Errors
     /// [`TraceError::InvalidParams`] for a tolerance that is not finite and
-    /// positive, a field not interpolated trilinearly, a degenerate window
+    /// positive, an octree built for another interpolant than the field's,
+    /// a degenerate window
     /// (direction or `u` zero, parallel or not finite; size not finite and
     /// positive; no cells or more than [`MAX_BEAM_CELLS`]).
     pub fn build(
@@ -77,7 +78,7 @@ impl BeamMask {
     ) -> Result<Self, TraceError> {
         let bad = Err(TraceError::InvalidParams);
         let BeamWindow { center, direction, u, size, cells } = *window;
-        if !(tolerance.is_finite() && tolerance > 0.0) || field.interp() != Interp::Trilinear {
+        if !(tolerance.is_finite() && tolerance > 0.0) || field.interp() != tree.interp() {
             return bad;
         }
         let finite = center.is_finite() && direction.is_finite() && u.is_finite();

@@ -5,17 +5,18 @@ use glam::DVec3;
 
 use super::{Octree, OctreeError};
 use crate::{
-    GridField, Interp, TraceError, TraceParams, TraceResult,
+    GridField, TraceError, TraceParams, TraceResult,
     trace::{Skip, trace_impl},
 };
 
-/// An octree over a gridded field's samples (see [`Octree`]).
+/// An octree over a gridded field's samples, bounding the field's own
+/// interpolant (trilinear or Catmull–Rom; see [`Octree`]).
 ///
 /// # Errors
 /// [`OctreeError`] for grids with fewer than 2 samples per axis.
 pub fn build_octree(field: &GridField) -> Result<Octree, OctreeError> {
     let g = field.grid();
-    Octree::build(g.dims(), g.data(), g.spacing().to_array())
+    Octree::build_for(field.interp(), g.dims(), g.data(), g.spacing().to_array())
 }
 
 /// Traces like [`crate::trace`], but wherever the octree says the field is
@@ -27,8 +28,8 @@ pub fn build_octree(field: &GridField) -> Result<Octree, OctreeError> {
 ///
 /// # Errors
 /// As [`crate::trace`]; also [`TraceError::InvalidParams`] for a
-/// tolerance that is not finite and positive, or a field whose interpolant
-/// is not trilinear (the octree's bounds are proven for trilinear only).
+/// tolerance that is not finite and positive, or an octree built for
+/// another interpolant than the field's (its bounds would not hold).
 pub fn trace_skipping(
     field: &GridField,
     tree: &Octree,
@@ -37,7 +38,7 @@ pub fn trace_skipping(
     params: &TraceParams,
     tolerance: f64,
 ) -> Result<TraceResult, TraceError> {
-    if !(tolerance.is_finite() && tolerance > 0.0) || field.interp() != Interp::Trilinear {
+    if !(tolerance.is_finite() && tolerance > 0.0) || field.interp() != tree.interp() {
         return Err(TraceError::InvalidParams);
     }
     let g = field.grid();
@@ -139,6 +140,7 @@ pub fn trace_skipping(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Interp;
 
     /// Found by the `octree` fuzz target: with a cell spacing of 3.4e38
     /// along x, `t + tiny` was absorbed by rounding and the node walk

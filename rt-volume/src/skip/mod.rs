@@ -5,8 +5,9 @@
 //! collimated beam meeting no rough brick straight through ([`BeamMask`]).
 //!
 //! The deflection a skip may miss is bounded per ray and reported
-//! ([`crate::TraceStats::skip_bound`]); the bound is proven for trilinear
-//! fields only, so skipping refuses other interpolants.
+//! ([`crate::TraceStats::skip_bound`]); the octree bounds the field's own
+//! interpolant (trilinear or Catmull–Rom), and skipping refuses a tree
+//! built for another.
 
 mod beam;
 mod march;

@@ -1,10 +1,24 @@
 //! A min/max octree over a gridded scalar field, for skipping the regions
 //! of a refractive-index volume where rays go (almost) straight.
 //!
-//! The grid's samples sit at integer *sample coordinates*; the trilinear
-//! interpolant on the dual cell `[i, i+1]×[j, j+1]×[k, k+1]` is bounded by
-//! its eight corner samples, and its gradient component along axis `a` by
-//! the largest corner difference along `a` divided by the spacing. Leaves
+//! The grid's samples sit at integer *sample coordinates*. On the dual cell
+//! `[i, i+1]×[j, j+1]×[k, k+1]`:
+//! - the **trilinear** interpolant is bounded by its eight corner samples,
+//!   and its gradient component along axis `a` by the largest corner
+//!   difference along `a` divided by the spacing;
+//! - the **Catmull–Rom** interpolant `f = Σ wᵢ(tx) wⱼ(ty) wₖ(tz) pᵢⱼₖ` reads
+//!   the 4³ samples `i−1 … i+2` (indices clamped at the faces, as the
+//!   sampler does). Its weights sum to 1 with `Σ|wᵢ(t)| ≤ W = 5/4` (at
+//!   `t = ½`), so `f` lies within the samples' range widened by
+//!   `(W³ − 1)/2 = 0.4765625` of it. Summing by parts, `∂f/∂x · h =
+//!   Σⱼₖ wⱼ wₖ Σₘ cₘ(tx) Δₘ` over the three differences `Δₘ = p_{m+1} − p_m`
+//!   along x, with `c₋₁ = (3t² − 4t + 1)/2`, `c₀ = (−6t² + 6t + 1)/2`,
+//!   `c₁ = (3t² − 2t)/2` and `Σ|cₘ| ≤ D = 3/2` (at `t = ½`); so
+//!   `|∂f/∂x| ≤ D·W² · max|Δ| / h = 2.34375 · max|Δ| / h` over the 3 × 4 × 4
+//!   differences along x in the neighbourhood (likewise y, z). Both bounds
+//!   are checked against the sampler in the tests.
+//!
+//! Leaves
 //! are bricks of [`BRICK`]³ dual cells; each node stores, over everything it
 //! covers, `min n`, `max n` and `max |∇n|` (the Euclidean norm of the
 //! per-axis bounds). Levels are dense arrays, finest first, over a
@@ -17,7 +31,7 @@
 
 use alloc::vec::Vec;
 
-use crate::math::sqrt;
+use crate::{Interp, math::sqrt};
 
 /// Dual cells per brick edge.
 pub const BRICK: usize = 4;
@@ -60,9 +74,18 @@ pub struct SmoothNode {
     pub stats: OctNode,
 }
 
+/// `(W³ − 1)/2`: how far past the samples' range (as a fraction of it) a
+/// Catmull–Rom interpolant can overshoot (see the module docs).
+const CATMULL_ROM_OVERSHOOT: f32 = 0.476_562_5;
+
+/// `D·W²`: the Catmull–Rom gradient bound per unit sample difference.
+const CATMULL_ROM_SLOPE: f32 = 2.343_75;
+
 /// The octree (see the module docs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Octree {
+    /// The interpolant whose bounds the nodes hold.
+    interp: Interp,
     /// Bricks per edge at the finest level (a power of two).
     side: usize,
     /// Dual cells per axis.
@@ -97,11 +120,25 @@ impl core::error::Error for OctreeError {}
 
 impl Octree {
     /// Builds the octree over `samples` (x fastest) of a `dims` grid with
-    /// the given spacing.
+    /// the given spacing, for the trilinear interpolant.
     ///
     /// # Errors
     /// [`OctreeError`] for bad dimensions or non-finite input.
     pub fn build(
+        dims: [usize; 3],
+        samples: &[f32],
+        spacing: [f64; 3],
+    ) -> Result<Self, OctreeError> {
+        Self::build_for(Interp::Trilinear, dims, samples, spacing)
+    }
+
+    /// Builds the octree for the interpolant `interp` (its nodes bound that
+    /// interpolant's values and gradient; see the module docs).
+    ///
+    /// # Errors
+    /// [`OctreeError`] for bad dimensions or non-finite input.
+    pub fn build_for(
+        interp: Interp,
         dims: [usize; 3],
         samples: &[f32],
         spacing: [f64; 3],
@@ -123,9 +160,13 @@ impl Octree {
         let at = |i: usize, j: usize, k: usize| samples[i + dims[0] * (j + dims[1] * k)];
         // Finest level: one node per brick.
         let mut finest = alloc::vec![OctNode::EMPTY; side * side * side];
-        for k in 0..cells[2] {
-            for j in 0..cells[1] {
-                for i in 0..cells[0] {
+        let cell_bound = |(lo, hi): (f32, f32), d: [f32; 3]| {
+            let g = (0..3).map(|a| f64::from(d[a]) / spacing[a]).map(|q| q * q).sum::<f64>();
+            OctNode { min: lo, max: hi, grad_max: (sqrt(g) * (1.0 + 1e-6)) as f32 }
+        };
+        match interp {
+            Interp::Trilinear => {
+                for_each_cell(cells, |[i, j, k]| {
                     let mut lo = f32::INFINITY;
                     let mut hi = f32::NEG_INFINITY;
                     let mut d = [0.0f32; 3];
@@ -145,13 +186,20 @@ impl Octree {
                             d[2] = d[2].max((at(i + di, j + dj, k + 1) - v).abs());
                         }
                     }
-                    let g =
-                        (0..3).map(|a| f64::from(d[a]) / spacing[a]).map(|q| q * q).sum::<f64>();
-                    let node =
-                        OctNode { min: lo, max: hi, grad_max: (sqrt(g) * (1.0 + 1e-6)) as f32 };
                     let b = (i / BRICK) + side * ((j / BRICK) + side * (k / BRICK));
-                    finest[b] = finest[b].merge(node);
-                }
+                    finest[b] = finest[b].merge(cell_bound((lo, hi), d));
+                });
+            }
+            Interp::CatmullRom => {
+                let w = Windows::new(dims, samples);
+                for_each_cell(cells, |[i, j, k]| {
+                    let (lo, hi, d) = w.cell(i, j, k);
+                    let over = CATMULL_ROM_OVERSHOOT * (hi - lo);
+                    let range = (lo - over, hi + over);
+                    let b = (i / BRICK) + side * ((j / BRICK) + side * (k / BRICK));
+                    finest[b] =
+                        finest[b].merge(cell_bound(range, d.map(|x| CATMULL_ROM_SLOPE * x)));
+                });
             }
         }
         let mut levels = alloc::vec![finest];
@@ -177,7 +225,14 @@ impl Octree {
                 sqrt(spacing.iter().map(|h| (size * h) * (size * h)).sum())
             })
             .collect();
-        Ok(Self { side, cells, levels, diag })
+        Ok(Self { interp, side, cells, levels, diag })
+    }
+
+    /// The interpolant the nodes bound: skipping through a field is exact
+    /// to its bound only if the field uses this interpolant.
+    #[must_use]
+    pub fn interp(&self) -> Interp {
+        self.interp
     }
 
     /// Number of levels (finest is 0).
@@ -306,9 +361,203 @@ impl Octree {
     }
 }
 
+/// Calls `f([i, j, k])` for every dual cell, x fastest.
+fn for_each_cell(cells: [usize; 3], mut f: impl FnMut([usize; 3])) {
+    for k in 0..cells[2] {
+        for j in 0..cells[1] {
+            for i in 0..cells[0] {
+                f([i, j, k]);
+            }
+        }
+    }
+}
+
+/// Per-sample maxima and minima over the Catmull–Rom neighbourhoods,
+/// computed separably (three passes of a sliding window per axis) so a
+/// cell costs a few lookups, not 4³.
+struct Windows {
+    dims: [usize; 3],
+    /// Samples' min and max over offsets `−1 … 2` on every axis.
+    lo: Vec<f32>,
+    hi: Vec<f32>,
+    /// Per axis `a`: `max |Δ|` of the differences along `a` that a cell's
+    /// interpolant reads (pairs `−1 … 1` along `a`, samples `−1 … 2`
+    /// across it).
+    diff: [Vec<f32>; 3],
+}
+
+impl Windows {
+    fn new(dims: [usize; 3], samples: &[f32]) -> Self {
+        let lo = window(dims, samples.to_vec(), [(-1, 2); 3], f32::min);
+        let hi = window(dims, samples.to_vec(), [(-1, 2); 3], f32::max);
+        let diff = [0, 1, 2].map(|a| {
+            // |p(x + eₐ) − p(x)| at each sample, 0 on the last one (its pair
+            // would clamp onto itself).
+            let stride = [1, dims[0], dims[0] * dims[1]][a];
+            let mut d = alloc::vec![0.0f32; samples.len()];
+            for (idx, v) in d.iter_mut().enumerate() {
+                let c = [idx % dims[0], (idx / dims[0]) % dims[1], idx / (dims[0] * dims[1])];
+                if c[a] + 1 < dims[a] {
+                    *v = (samples[idx + stride] - samples[idx]).abs();
+                }
+            }
+            let mut reach = [(-1, 2); 3];
+            reach[a] = (-1, 1);
+            window(dims, d, reach, f32::max)
+        });
+        Self { dims, lo, hi, diff }
+    }
+
+    /// `(min, max, max |Δ| per axis)` over dual cell `(i, j, k)`'s
+    /// neighbourhood.
+    fn cell(&self, i: usize, j: usize, k: usize) -> (f32, f32, [f32; 3]) {
+        let idx = i + self.dims[0] * (j + self.dims[1] * k);
+        (self.lo[idx], self.hi[idx], [self.diff[0][idx], self.diff[1][idx], self.diff[2][idx]])
+    }
+}
+
+/// `data` with each value replaced by `pick` over the window
+/// `reach[a].0 ..= reach[a].1` around it on every axis `a` (indices clamped
+/// to the grid, as the Catmull–Rom sampler clamps).
+fn window(
+    dims: [usize; 3],
+    mut data: Vec<f32>,
+    reach: [(isize, isize); 3],
+    pick: fn(f32, f32) -> f32,
+) -> Vec<f32> {
+    let mut line = Vec::new();
+    for a in 0..3 {
+        let (n, stride) = (dims[a], [1, dims[0], dims[0] * dims[1]][a]);
+        let lines = data.len() / n;
+        for l in 0..lines {
+            // The first index of line `l` along axis `a`.
+            let start = match a {
+                0 => l * n,
+                1 => (l % dims[0]) + (l / dims[0]) * dims[0] * dims[1],
+                _ => l,
+            };
+            line.clear();
+            line.extend((0..n).map(|t| data[start + t * stride]));
+            for t in 0..n {
+                let (from, to) = (
+                    (t as isize + reach[a].0).clamp(0, n as isize - 1) as usize,
+                    (t as isize + reach[a].1).clamp(0, n as isize - 1) as usize,
+                );
+                data[start + t * stride] = line[from..=to].iter().copied().fold(line[from], pick);
+            }
+        }
+    }
+    data
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The Catmull–Rom constants: `Σ|wᵢ(t)| ≤ 5/4` and `Σ|cₘ(t)| ≤ 3/2`
+    /// over `t ∈ [0, 1]` (finely sampled; the maxima are at `t = ½`).
+    #[test]
+    fn catmull_rom_weight_sums_are_bounded_as_stated() {
+        let (mut w_max, mut c_max) = (0.0f64, 0.0f64);
+        for n in 0..=10_000 {
+            let t = f64::from(n) / 10_000.0;
+            let (t2, t3) = (t * t, t * t * t);
+            let w = [
+                0.5 * (-t3 + 2.0 * t2 - t),
+                0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
+                0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+                0.5 * (t3 - t2),
+            ];
+            let c = [
+                0.5 * (3.0 * t2 - 4.0 * t + 1.0),
+                0.5 * (-6.0 * t2 + 6.0 * t + 1.0),
+                0.5 * (3.0 * t2 - 2.0 * t),
+            ];
+            w_max = w_max.max(w.iter().map(|v| v.abs()).sum());
+            c_max = c_max.max(c.iter().map(|v| v.abs()).sum());
+        }
+        assert!((w_max - 1.25).abs() < 1e-12 && (c_max - 1.5).abs() < 1e-12, "{w_max} {c_max}");
+        let (w3, slope) = (w_max.powi(3), c_max * w_max * w_max);
+        assert_eq!(((w3 - 1.0) / 2.0) as f32, CATMULL_ROM_OVERSHOOT);
+        assert_eq!(slope as f32, CATMULL_ROM_SLOPE);
+    }
+
+    /// The Catmull–Rom slope bound is attained: samples `q(i)·s(j)·s(k)`
+    /// with `q = (0, −1, 0, −1)` (differences −1, +1, −1, matching the signs
+    /// of `cₘ(½)`) and `s = (−1, 1, 1, −1)` (the signs of `wⱼ(½)`) give
+    /// `∂f/∂x = D·W² · max|Δ| / h` at the cell centre, so no smaller
+    /// constant would do.
+    #[test]
+    fn catmull_rom_slope_bound_is_tight() {
+        let (q, sgn) = ([0.0f32, -1.0, 0.0, -1.0], [-1.0f32, 1.0, 1.0, -1.0]);
+        let mut data = alloc::vec::Vec::new();
+        for sk in sgn {
+            for sj in sgn {
+                for qi in q {
+                    data.push(5.0 + qi * sj * sk);
+                }
+            }
+        }
+        let h = 0.5;
+        let grid = crate::Grid::new([4; 3], glam::DVec3::ZERO, glam::DVec3::splat(h), data.clone())
+            .unwrap();
+        let (_, g) = grid.sample(glam::DVec3::splat(1.5 * h), Interp::CatmullRom);
+        let (_, _, d) = Windows::new([4; 3], &data).cell(1, 1, 1);
+        let bound = f64::from(CATMULL_ROM_SLOPE * d[0]) / h;
+        assert_eq!(d[0], 1.0);
+        assert!((g.x.abs() - bound).abs() < 1e-9 * bound, "{} vs {bound}", g.x);
+    }
+
+    /// On random grids, the interpolant's value and gradient at random
+    /// points (faces included) stay within the bounds the finest node over
+    /// them holds — for both interpolants.
+    #[test]
+    fn nodes_bound_the_interpolant_they_were_built_for() {
+        let mut state = 0x1234_5678_9abc_def0u64;
+        // SplitMix64: a fixed stream of uniform numbers in [0, 1).
+        let mut next = || {
+            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for interp in [Interp::Trilinear, Interp::CatmullRom] {
+            for trial in 0..6 {
+                let dims = [5 + trial, 7, 4 + 2 * trial];
+                let spacing = [0.5, 0.25 + 0.1 * trial as f64, 1.0];
+                let n = dims[0] * dims[1] * dims[2];
+                // Rough data: sharp steps and noise, where overshoot shows.
+                let data: alloc::vec::Vec<f32> = (0..n)
+                    .map(|_| {
+                        if next() < 0.2 { 2.0 + next() as f32 } else { 1.0 + 0.01 * next() as f32 }
+                    })
+                    .collect();
+                let origin = glam::DVec3::new(-1.0, 0.5, 2.0);
+                let grid = crate::Grid::new(dims, origin, spacing.into(), data.clone()).unwrap();
+                let tree = Octree::build_for(interp, dims, &data, spacing).unwrap();
+                for _ in 0..2000 {
+                    let p = [0, 1, 2].map(|a| next() * (dims[a] - 1) as f64);
+                    let b = tree.brick_of(p).unwrap();
+                    let node = tree.levels[0][b[0] + tree.side * (b[1] + tree.side * b[2])];
+                    let x = origin + glam::DVec3::from(p) * glam::DVec3::from(spacing);
+                    let (v, g) = grid.sample(x, interp);
+                    assert!(
+                        v >= f64::from(node.min) - 1e-6 && v <= f64::from(node.max) + 1e-6,
+                        "{interp:?}: value {v} outside [{}, {}]",
+                        node.min,
+                        node.max
+                    );
+                    assert!(
+                        g.length() <= f64::from(node.grad_max) * (1.0 + 1e-5),
+                        "{interp:?}: |∇| {} above {}",
+                        g.length(),
+                        node.grad_max
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn stats_bound_a_linear_ramp_and_uniform_regions_are_smooth() {

@@ -10,7 +10,7 @@ use std::{fmt::Write as _, hint::black_box, path::Path};
 use glam::{Vec2, Vec3};
 use rt_accel::BuildParams;
 use rt_benches::{
-    plot::{PALETTE, Series, loglog},
+    plot::{Plot, Series, loglog},
     scenes,
 };
 use rt_core::{Camera, ColorMap, Frame, Projection, Ray, SceneQuery};
@@ -177,10 +177,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         verdicts,
         plots: vec![(
             "render.png".into(),
-            format!(
-                "AO rmse against a 256-ray reference (y) against seconds (x) for 1–16 AO rays ({}); rings: Pareto front",
-                PALETTE[0].1
-            ),
+            "AO rmse against a 256-ray reference (y) against seconds (x) for 1–16 AO rays; rings: Pareto front".into(),
         )],
     })
 }
@@ -225,13 +222,18 @@ fn ao_error(dir: &Path, scene: &SurfaceScene<'_>, quick: bool) -> Result<String,
     }
     std::fs::write(dir.join("render-ao.csv"), &csv).map_err(|e| e.to_string())?;
     let png = dir.join("render.png");
-    loglog(&[Series { points, color: PALETTE[0].0 }], 640, 480, &png)?;
+    let plot = Plot {
+        title: format!("Ambient occlusion noise against time ({size}², 1–16 AO rays per pixel)"),
+        x_label: "seconds per frame (one pass, all cores, best of 3)".into(),
+        y_label: "rmse against the 256-ray reference (linear RGB)".into(),
+        series: vec![Series { name: "AO, 1 · 2 · 4 · 8 · 16 rays".into(), points }],
+    };
+    loglog(&plot, 800, 560, &png)?;
     Ok(format!(
         "\n### AO error against run time ({size}², one pass, all cores, best of 3; reference: 256 AO rays)\n\n{md}\n\
          - Monte-Carlo AO: rmse × √N should stay flat (error ∝ N^-1/2).\n\
-         wrote {} and {} (x: seconds, y: rmse, {})\n",
+         wrote {} and {}\n",
         dir.join("render-ao.csv").display(),
-        png.display(),
-        PALETTE[0].1
+        png.display()
     ))
 }

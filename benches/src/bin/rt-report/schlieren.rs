@@ -7,7 +7,7 @@
 use std::{fmt::Write as _, path::Path};
 
 use rt_benches::{
-    plot::{PALETTE, Series, loglog},
+    plot::{Plot, Series, loglog},
     scenes::{knife_bench, sparse_bumps},
 };
 use rt_photo::{Film, Filter};
@@ -73,16 +73,29 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         }
     }
     std::fs::write(dir.join("schlieren.csv"), &csv).map_err(|e| e.to_string())?;
-    let series: Vec<Series> = ["original", "rt", "rt-2voxel"]
-        .iter()
-        .enumerate()
-        .map(|(i, m)| Series {
-            points: rows.iter().filter(|r| r.0 == *m).map(|r| (r.2, r.3)).collect(),
-            color: PALETTE[i].0,
-        })
-        .collect();
+    let series: Vec<Series> = [
+        ("original", "original: Euler, 1-voxel steps"),
+        ("rt", "rt: leapfrog + octree, 1 voxel"),
+        ("rt-2voxel", "rt-2voxel: leapfrog + octree, 2 voxels"),
+    ]
+    .iter()
+    .map(|&(m, name)| Series {
+        name: name.into(),
+        points: rows.iter().filter(|r| r.0 == m).map(|r| (r.2, r.3)).collect(),
+    })
+    .collect();
     let png = dir.join("schlieren.png");
-    loglog(&series, 640, 480, &png)?;
+    let plot = Plot {
+        title: format!(
+            "Schlieren, {FILM}² film: error against time over {} … {} photons per pixel",
+            strata[0].pow(2),
+            strata[strata.len() - 1].pow(2)
+        ),
+        x_label: "seconds per film (best of 3)".into(),
+        y_label: "rmse against the converged film (normalized)".into(),
+        series,
+    };
+    loglog(&plot, 800, 560, &png)?;
     let mut md = String::from(
         "| method | photons | seconds (best of 3) | spread | photons/s | rmse |\n|---|---|---|---|---|---|\n",
     );
@@ -143,7 +156,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         verdicts,
         plots: vec![(
             "schlieren.png".into(),
-            "rmse against the reference (y) against seconds (x); original red, rt blue, rt-2voxel green; rings: Pareto front".into(),
+            "rmse against the reference (y) against seconds (x), one line per method over photons per pixel; rings: Pareto front".into(),
         )],
     })
 }
