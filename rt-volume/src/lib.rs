@@ -12,7 +12,10 @@
 //! - [`trace`]: straight to the bounds, integrated inside them with
 //!   [`Method::Euler`] (baseline), [`Method::Rk4`], [`Method::Adaptive`]
 //!   (Dormand–Prince 5(4)) or [`Method::Symplectic`] (leapfrog), landed
-//!   exactly on the surface where the ray leaves; reports the exit point,
+//!   exactly on the surface where the ray leaves, or stopped exactly at an
+//!   arc length inside the bounds ([`TraceParams::max_length`]); the last
+//!   step is shortened onto the event and sees the field's own values, so
+//!   every scheme keeps its order to the end. Reports the end point,
 //!   direction, optical path and [`TraceStats`].
 //!
 //! All arithmetic is f64: the oracles are met to 1e-7 relative.
