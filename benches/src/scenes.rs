@@ -140,6 +140,7 @@ pub fn knife_bench(params: TraceParams, strata: u32) -> Bench {
         u: DVec3::X,
         width: 1.0,
         height: 1.0,
+        image_plane: 0.6,
         film_distance: 0.0,
         mode: Mode::Schlieren(Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.0, h: 4e-3 }),
         weighting: Weighting::Weight,

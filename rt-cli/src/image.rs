@@ -57,6 +57,14 @@ impl From<WriteError> for String {
     }
 }
 
+/// The companion of a PNG: `<path's stem>-<suffix>.png` in its folder
+/// (`out/a.png`, `figure` → `out/a-figure.png`).
+#[must_use]
+pub fn beside(path: &Path, suffix: &str) -> PathBuf {
+    let stem = path.file_stem().map_or("image".into(), |s| s.to_string_lossy());
+    path.with_file_name(format!("{stem}-{suffix}.png"))
+}
+
 /// Creates `path`'s folder if it has one.
 fn create_parent(path: &Path) -> Result<(), WriteError> {
     match path.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -66,21 +74,93 @@ fn create_parent(path: &Path) -> Result<(), WriteError> {
     }
 }
 
+/// Encodes `data` (rows top first; 16-bit samples big-endian, as PNG
+/// wants) as a PNG of `color` and `depth`; `srgb` marks it sRGB, else
+/// linear (gAMA 1.0); `text` adds one `tEXt` comment. Creates the folder.
+fn encode(
+    path: &Path,
+    (width, height): (u32, u32),
+    (color, depth): (png::ColorType, png::BitDepth),
+    srgb: bool,
+    text: Option<&str>,
+    data: &[u8],
+) -> Result<(), WriteError> {
+    create_parent(path)?;
+    let encode = |source| WriteError::Encode { path: path.to_path_buf(), source };
+    let f = File::create(path).map_err(|source| WriteError::Io { path: path.into(), source })?;
+    let mut enc = png::Encoder::new(BufWriter::new(f), width, height);
+    enc.set_color(color);
+    enc.set_depth(depth);
+    if srgb {
+        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    } else {
+        enc.set_source_gamma(png::ScaledFloat::new(1.0));
+    }
+    if let Some(text) = text {
+        enc.add_text_chunk("Comment".to_string(), text.to_string()).map_err(encode)?;
+    }
+    let mut w = enc.write_header().map_err(encode)?;
+    w.write_image_data(data).map_err(encode)?;
+    w.finish().map_err(encode)
+}
+
 /// Writes a frame as an 8-bit sRGB RGBA PNG (straight alpha); creates
 /// the folder.
 ///
 /// # Errors
 /// [`WriteError`] naming the file or folder.
 pub fn write_png(frame: &Frame, path: &Path) -> Result<(), WriteError> {
-    create_parent(path)?;
-    let encode = |source| WriteError::Encode { path: path.to_path_buf(), source };
-    let f = File::create(path).map_err(|source| WriteError::Io { path: path.into(), source })?;
-    let mut enc = png::Encoder::new(BufWriter::new(f), frame.width(), frame.height());
-    enc.set_color(png::ColorType::Rgba);
-    enc.set_depth(png::BitDepth::Eight);
-    enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-    let mut w = enc.write_header().map_err(encode)?;
-    w.write_image_data(&frame.to_srgba8()).map_err(encode)
+    let format = (png::ColorType::Rgba, png::BitDepth::Eight);
+    encode(path, (frame.width(), frame.height()), format, true, None, &frame.to_srgba8())
+}
+
+/// Writes 8-bit sRGB RGB pixels (rows top first) as a PNG; creates the
+/// folder.
+///
+/// # Errors
+/// [`WriteError`] naming the file or folder.
+///
+/// # Panics
+/// If `rgb` does not hold `3 × width × height` bytes.
+pub fn write_rgb8(rgb: &[u8], width: u32, height: u32, path: &Path) -> Result<(), WriteError> {
+    assert_eq!(rgb.len() as u64, 3 * u64::from(width) * u64::from(height), "RGB buffer size");
+    let format = (png::ColorType::Rgb, png::BitDepth::Eight);
+    encode(path, (width, height), format, true, None, rgb)
+}
+
+/// Composites `frame` (premultiplied) over an opaque vertical gradient
+/// of linear RGB, `top` in the first row to `bottom` in the last (equal
+/// for a plain colour): `c + (1 − α)·background`, alpha 1 everywhere.
+/// Depth is left as it is.
+pub fn over_background(frame: &mut Frame, top: [f32; 3], bottom: [f32; 3]) {
+    let (w, h) = (frame.width() as usize, frame.height() as usize);
+    for (y, row) in frame.pixels_mut().chunks_mut(w.max(1)).enumerate() {
+        let t = if h > 1 { y as f32 / (h - 1) as f32 } else { 0.0 };
+        let bg: [f32; 3] = core::array::from_fn(|k| top[k] + t * (bottom[k] - top[k]));
+        for p in row {
+            let clear = 1.0 - p.color[3].clamp(0.0, 1.0);
+            for (c, b) in p.color.iter_mut().zip(bg) {
+                *c += clear * b;
+            }
+            p.color[3] = 1.0;
+        }
+    }
+}
+
+/// A film's image as an opaque frame: normalised to the background and
+/// multiplied by `scale` (0.5 puts an undisturbed, uncut background at
+/// mid grey).
+///
+/// # Errors
+/// [`WriteError::Frame`] for an image too large for a frame.
+pub fn film_frame(film: &rt_photo::Film, scale: f32) -> Result<Frame, WriteError> {
+    let size = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+    let mut frame =
+        Frame::new(size(film.width()), size(film.height())).map_err(WriteError::Frame)?;
+    for (p, c) in frame.pixels_mut().iter_mut().zip(film.normalized()) {
+        *p = Pixel { color: [c[0] * scale, c[1] * scale, c[2] * scale, 1.0], depth: 0.0 };
+    }
+    Ok(frame)
 }
 
 /// Writes a film's image, normalised to the background and multiplied by
@@ -90,11 +170,45 @@ pub fn write_png(frame: &Frame, path: &Path) -> Result<(), WriteError> {
 /// # Errors
 /// [`WriteError`] naming the file or folder.
 pub fn write_film(film: &rt_photo::Film, scale: f32, path: &Path) -> Result<(), WriteError> {
-    let size = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
-    let mut frame =
-        Frame::new(size(film.width()), size(film.height())).map_err(WriteError::Frame)?;
-    for (p, c) in frame.pixels_mut().iter_mut().zip(film.normalized()) {
-        *p = Pixel { color: [c[0] * scale, c[1] * scale, c[2] * scale, 1.0], depth: 0.0 };
+    write_png(&film_frame(film, scale)?, path)
+}
+
+/// The 16-bit value of the light an undisturbed beam gives with nothing
+/// cut: `--raw16` images store `RAW16_UNIT × I / I₀` (linear, clamped to
+/// 65535), so values up to twice the uncut background are kept.
+pub const RAW16_UNIT: f64 = 32768.0;
+
+/// Writes a film's image as a linear 16-bit PNG for measurements: each
+/// sample is `RAW16_UNIT × I/I₀` rounded and clamped to `0..=65535`, `I/I₀`
+/// the intensity relative to an undisturbed beam with nothing cut
+/// ([`rt_photo::Film::normalized_f64`]; 1 → 32768). So a knife edge's
+/// undisturbed background (half the source cut) reads 16384, a
+/// shadowgraph's 32768, its caustics up to 2× before they clip. Grey
+/// (one channel, the mean of three) unless `color` (RGB, for the colour
+/// filter). Marked linear (gAMA 1.0), with the scale in a `tEXt`
+/// comment. Creates the folder.
+///
+/// # Errors
+/// [`WriteError`] naming the file or folder, or an image too large.
+pub fn write_film16(film: &rt_photo::Film, color: bool, path: &Path) -> Result<(), WriteError> {
+    let size = |n: usize| u32::try_from(n).map_err(|_| WriteError::Frame(FrameError::TooLarge));
+    let (w, h) = (size(film.width())?, size(film.height())?);
+    let to16 = |x: f64| -> [u8; 2] {
+        let v = if x > 0.0 { (x * RAW16_UNIT).round().min(65535.0) } else { 0.0 };
+        (v as u16).to_be_bytes()
+    };
+    let pixels = film.normalized_f64();
+    let mut data = Vec::with_capacity(pixels.len() * if color { 6 } else { 2 });
+    for c in pixels {
+        if color {
+            data.extend(c.iter().flat_map(|&x| to16(x)));
+        } else {
+            data.extend(to16((c[0] + c[1] + c[2]) / 3.0));
+        }
     }
-    write_png(&frame, path)
+    let kind = if color { png::ColorType::Rgb } else { png::ColorType::Grayscale };
+    let text = format!(
+        "rt: linear intensity; value / {RAW16_UNIT} = I/I0, I0 the undisturbed beam with nothing cut"
+    );
+    encode(path, (w, h), (kind, png::BitDepth::Sixteen), false, Some(&text), &data)
 }

@@ -24,6 +24,7 @@
 
 pub mod demo;
 pub mod distributed;
+mod figure;
 pub mod image;
 pub mod info;
 pub mod optics;

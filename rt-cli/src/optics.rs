@@ -119,18 +119,19 @@ impl Volume {
     }
 
     /// A bench looking through the whole volume along `axis`: the beam
-    /// covers the box's cross-section and starts upstream of it; the film
-    /// images the field's mid-plane. Mode and film distance are the
-    /// caller's.
+    /// covers the box's cross-section and starts upstream of it; the optics
+    /// image the volume's mid-plane, the film sits `film_distance` behind
+    /// it (negative: in front). Mode and film distance are the caller's.
     #[must_use]
     pub fn bench(&self, axis: Axis, mode: Mode, film_distance: f64) -> Bench {
         let b = self.field.grid().bounds();
         let (direction, u) = axis.frame();
         let v = direction.cross(u);
         let ext = b.max - b.min;
+        let upstream = 0.5 * ext.dot(direction) + 0.1 * ext.length();
         Bench {
-            center: 0.5 * (b.min + b.max)
-                - (0.5 * ext.dot(direction) + 0.1 * ext.length()) * direction,
+            center: 0.5 * (b.min + b.max) - upstream * direction,
+            image_plane: upstream,
             direction,
             u,
             width: ext.dot(u),

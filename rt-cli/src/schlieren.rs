@@ -5,10 +5,12 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use clap::ValueEnum;
-use rt_photo::{Cutoff, Film, FilterImage, Mode};
-use rt_volume::{GLADSTONE_DALE_AIR, io::read_grid};
+use rt_core::Frame;
+use rt_photo::{Bench, Cutoff, Film, FilterImage, Mode};
+use rt_volume::{GLADSTONE_DALE_AIR, glam::DVec3, io::read_grid};
 
 use crate::{
+    figure::{self, Figure, Legend},
     image,
     optics::{Axis, Interpolation, Quantity, Survey, Volume},
     parse,
@@ -103,9 +105,24 @@ pub struct Args {
     /// Seed of every random choice: the same seed gives the same image.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// PNG to write.
+    /// PNG to write (8-bit sRGB, the undisturbed background mid grey, or
+    /// white for the colour filter).
     #[arg(long, default_value = "out/schlieren.png")]
     pub out: PathBuf,
+    /// Also write `<stem>-figure.png` beside it: the image with axes in
+    /// metres, tick values, a scale bar, the optics in its title and, for
+    /// the colour filter, the deflection wheel [default: on].
+    #[arg(long, overrides_with = "no_figure")]
+    pub figure: bool,
+    /// Skip the figure.
+    #[arg(long, overrides_with = "figure")]
+    pub no_figure: bool,
+    /// Also write `<stem>-16bit.png`: linear 16-bit samples, 32768 × the
+    /// intensity relative to an undisturbed beam with nothing cut (a knife
+    /// edge's background reads 16384, a shadowgraph's 32768); grey, RGB
+    /// for the colour filter.
+    #[arg(long)]
+    pub raw16: bool,
 }
 
 /// The most photons one run may trace.
@@ -169,12 +186,14 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     render(&volume, a)
 }
 
-/// Renders `volume` as `a` says (its file and sample options aside) and
-/// writes the PNG; prints one summary line.
+/// The bench `a` describes for `volume`, its optics chosen from a survey
+/// of the deflections where `a` leaves them out, and a line saying what
+/// was chosen (every user-facing render goes through here: the CLI, the
+/// demo, the report's noise measurement).
 ///
 /// # Errors
-/// Bad optics, too many photons, an unwritable output.
-pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
+/// Too many photons for one run; a failing survey.
+pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<(Bench, String)> {
     let probe = volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
     let height = ((f64::from(a.size)) * probe.height / probe.width).round().max(1.0);
     let photons = u64::from(a.size) * height as u64 * u64::from(a.photons.next_multiple_of(4));
@@ -198,12 +217,90 @@ pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
             );
         }
     }
-    let bench = volume.bench(a.axis, mode, film_distance);
+    Ok((volume.bench(a.axis, mode, film_distance), chosen))
+}
+
+/// Renders `volume` as `a` says (its file and sample options aside) and
+/// writes the PNG; prints one summary line.
+///
+/// # Errors
+/// Bad optics, too many photons, an unwritable output.
+pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
+    let (bench, chosen) = prepare(volume, a)?;
     let (film, seconds) = volume.render(&bench, a.size as usize, a.photons, a.seed)?;
     let scale = if matches!(bench.mode, Mode::Schlieren(Cutoff::None)) { 0.5 } else { 1.0 };
-    image::write_film(&film, scale, &a.out)?;
-    println!("{}", summary(&a.out, &film, seconds, &chosen));
+    let frame = image::film_frame(&film, scale)?;
+    image::write_png(&frame, &a.out)?;
+    let mut written = vec![a.out.clone()];
+    if a.raw16 {
+        let path = image::beside(&a.out, "16bit");
+        let color = matches!(bench.mode, Mode::Schlieren(Cutoff::Color(_)));
+        image::write_film16(&film, color, &path)?;
+        written.push(path);
+    }
+    if !a.no_figure {
+        let path = image::beside(&a.out, "figure");
+        figure(volume, a, &bench, &frame, &chosen).write(&path)?;
+        written.push(path);
+    }
+    println!("{}", summary(&written, &film, seconds, &chosen));
     Ok(())
+}
+
+/// The name of the coordinate axis `d` (a unit axis) runs along.
+fn axis_name(d: DVec3) -> &'static str {
+    let a = d.abs();
+    if a.x >= a.y && a.x >= a.z {
+        "x"
+    } else if a.y >= a.z {
+        "y"
+    } else {
+        "z"
+    }
+}
+
+/// The figure of `frame`: axes from the volume's bounds along the image
+/// axes u and v, the mode and optics in the title, the colour filter's
+/// wheel as its legend.
+fn figure(volume: &Volume, a: &Args, bench: &Bench, frame: &Frame, chosen: &str) -> Figure {
+    let b = volume.field.grid().bounds();
+    let v = bench.direction.cross(bench.u);
+    // The image spans the box's cross-section: u left to right, v bottom
+    // to top (the box's coordinates along each, whatever the axis's sign).
+    let span = |d: DVec3| {
+        let (p, q) = (b.min.dot(d), b.max.dot(d));
+        p.min(q)..p.max(q)
+    };
+    let axes = (
+        figure::Axis { name: axis_name(bench.u).into(), range: span(bench.u) },
+        figure::Axis { name: axis_name(v).into(), range: span(v) },
+    );
+    let mode = match a.cutoff {
+        CutoffKind::Knife => "Knife-edge schlieren",
+        CutoffKind::Graded => "Graded-filter schlieren",
+        CutoffKind::Pinhole => "Pinhole (bright-field) schlieren",
+        CutoffKind::DarkField => "Dark-field schlieren",
+        CutoffKind::Color => "Colour schlieren",
+        CutoffKind::None if bench.film_distance != 0.0 => "Shadowgraph",
+        CutoffKind::None => "Transmission (no cutoff)",
+        CutoffKind::Interferometry => "Interferogram",
+    };
+    let file = a
+        .file
+        .file_name()
+        .map_or(a.file.display().to_string(), |f| f.to_string_lossy().into_owned());
+    let legend = match &bench.mode {
+        Mode::Schlieren(Cutoff::Color(filter)) => Legend::Wheel(filter.clone()),
+        _ => Legend::None,
+    };
+    let along = if bench.direction.element_sum() < 0.0 { "−" } else { "+" };
+    Figure {
+        image: figure::Image::from_frame(frame),
+        title: format!("{mode}: {file}, beam along {along}{}", axis_name(bench.direction)),
+        subtitle: format!("{chosen}; {} photons per pixel", a.photons.next_multiple_of(4)),
+        axes: Some(axes),
+        legend,
+    }
 }
 
 impl Args {
@@ -230,10 +327,11 @@ impl Args {
 }
 
 /// One line: what was written, how many photons in how long, the optics.
-pub(crate) fn summary(out: &std::path::Path, film: &Film, seconds: f64, chosen: &str) -> String {
+pub(crate) fn summary(written: &[PathBuf], film: &Film, seconds: f64, chosen: &str) -> String {
+    let files: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     format!(
         "wrote {} ({}×{}, {} photons in {seconds:.2} s, {:.2} M photons/s; {chosen})",
-        out.display(),
+        files.join(", "),
         film.width(),
         film.height(),
         film.emitted,

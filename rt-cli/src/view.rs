@@ -6,9 +6,15 @@ use std::{path::PathBuf, time::Instant};
 use anyhow::{Context, bail};
 use clap::ValueEnum;
 use rt_core::{Camera, ColorMap, Projection, glam::Vec3};
-use rt_surface::{Light, Paint, Renderer, Settings, SurfaceScene, io::read_mesh};
+use rt_surface::{
+    Light, Material, Mesh, MeshError, Paint, Renderer, Settings, SurfaceScene, io::read_mesh,
+};
 
-use crate::{image::write_png, parse, progress};
+use crate::{
+    figure::{Figure, Image, Legend, significant},
+    image::{beside, over_background, write_png},
+    parse, progress,
+};
 
 /// The colour maps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -20,6 +26,36 @@ pub enum ColorMapName {
     /// Black to white.
     Grayscale,
 }
+
+/// What the render is drawn on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Background {
+    /// White: the page a paper is printed on, so the object sits on it
+    /// with no visible frame, prints without ink and crops cleanly.
+    White,
+    /// Black (slides, dark pages).
+    Black,
+    /// A gentle vertical gradient, pale blue-grey at the top to white.
+    Gradient,
+    /// None: alpha 0 where nothing was hit (to composite elsewhere).
+    Transparent,
+}
+
+impl Background {
+    /// Linear RGB at the top and bottom rows, or `None` for transparent.
+    #[must_use]
+    pub fn colors(self) -> Option<([f32; 3], [f32; 3])> {
+        match self {
+            Self::White => Some(([1.0; 3], [1.0; 3])),
+            Self::Black => Some(([0.0; 3], [0.0; 3])),
+            Self::Gradient => Some(([0.62, 0.68, 0.76], [1.0; 3])),
+            Self::Transparent => None,
+        }
+    }
+}
+
+/// The ground plane's colour (linear RGB): a neutral mid grey.
+const GROUND: [f32; 3] = [0.5; 3];
 
 /// `rt view MESH`: options.
 #[derive(Debug, clap::Args)]
@@ -85,6 +121,43 @@ pub struct Args {
     /// Seed of the sample streams (the same seed gives the same image).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// What the mesh is drawn on (transparent: alpha 0 where nothing was
+    /// hit).
+    #[arg(long, value_enum, default_value_t = Background::White)]
+    pub background: Background,
+    /// Show the facets: ignore the file's normals and compute no smooth
+    /// ones [default: the file's normals, else angle-weighted vertex
+    /// normals].
+    #[arg(long)]
+    pub flat: bool,
+    /// A grey ground plane just below the mesh's lowest point along --up,
+    /// 6 bounding radii wide, that takes its shadow and AO (with --shadows,
+    /// --ao).
+    #[arg(long)]
+    pub ground: bool,
+    /// Also write `<stem>-figure.png`: the render with a colour bar
+    /// labelled with the scalar's name and range.
+    #[arg(long)]
+    pub figure: bool,
+}
+
+/// Whether the range `lo..=hi` of a scalar is below float resolution:
+/// equal ends, or a span of at most 4 ulps of the larger magnitude
+/// (stretching a colour map over it would paint round-off as noise).
+fn is_constant(lo: f32, hi: f32) -> bool {
+    hi - lo <= 4.0 * f32::EPSILON * lo.abs().max(hi.abs())
+}
+
+/// A square of `6 × radius` side facing `up` (unit), centred under
+/// `center`, its height along `up` just below `lowest`: two triangles,
+/// counter-clockwise seen from above.
+fn ground_plane(center: Vec3, radius: f32, up: Vec3, lowest: f32) -> Result<Mesh, MeshError> {
+    let e1 = up.any_orthonormal_vector();
+    let e2 = up.cross(e1);
+    let c = center + up * (lowest - 0.01 * radius - center.dot(up));
+    let a = 3.0 * radius;
+    let corners = [-e1 - e2, e1 - e2, e1 + e2, -e1 + e2].map(|d| c + a * d).to_vec();
+    Mesh::new(corners, vec![[0, 1, 2], [0, 2, 3]], None)
 }
 
 /// Runs `rt view`.
@@ -94,31 +167,69 @@ pub struct Args {
 /// camera, an unwritable output.
 pub fn run(o: &Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
-    let data = read_mesh(&o.file)?;
-    let mesh = data.into_mesh(o.scalar.as_deref()).with_context(|| o.file.display().to_string())?;
+    let mut data = read_mesh(&o.file)?;
+    if o.flat {
+        data.normals = None;
+    }
+    let mut mesh =
+        data.into_mesh(o.scalar.as_deref()).with_context(|| o.file.display().to_string())?;
     if mesh.indices().is_empty() {
         bail!("{}: no triangles to render", o.file.display());
     }
-    let paint = match mesh.scalars() {
+    if !o.flat && mesh.normals().is_none() {
+        mesh = mesh.with_smooth_normals();
+    }
+    let name = o.scalar.as_deref().unwrap_or("scalar");
+    // The map and whether the scalar is constant (drawn in one colour).
+    let mapped = match mesh.scalars() {
         Some(s) => {
             let map = match o.colormap {
                 ColorMapName::Viridis => ColorMap::viridis(),
                 ColorMapName::CoolToWarm => ColorMap::cool_to_warm(),
                 ColorMapName::Grayscale => ColorMap::grayscale(),
             };
-            let (lo, hi) = o.range.or_else(|| finite_range(s)).unwrap_or((0.0, 1.0));
-            let hi = if hi > lo { hi } else { lo + 1.0 };
-            Paint::Mapped(map.with_range(lo, hi)?)
+            let (lo, hi, constant) = match (o.range, finite_range(s)) {
+                (Some((lo, hi)), _) => (lo, hi, false),
+                (None, Some((lo, hi))) if is_constant(lo, hi) => {
+                    let what = if lo == hi {
+                        format!("every value is {lo}")
+                    } else {
+                        format!("{lo} to {hi}, within float round-off")
+                    };
+                    eprintln!(
+                        "rt: warning: scalar {name} is constant ({what}); drawn in one colour"
+                    );
+                    // An empty range maps every value to the map's middle.
+                    let mid = lo + 0.5 * (hi - lo);
+                    (mid, mid, true)
+                }
+                (None, Some((lo, hi))) => (lo, hi, false),
+                // No finite value: every vertex gets the NaN colour.
+                (None, None) => (0.0, 1.0, false),
+            };
+            Some((map.with_range(lo, hi)?, constant))
         }
-        None => Paint::Solid(o.color),
+        None => None,
     };
+    let paint = mapped.map_or(Paint::Solid(o.color), |(map, _)| Paint::Mapped(map));
     // The view framing the mesh's bounding sphere.
     let (lo, hi) =
         mesh.positions().iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| (lo.min(p), hi.max(p)));
     let center = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(f32::MIN_POSITIVE);
     let triangles = mesh.indices().len();
-    let world = SurfaceScene::from_mesh(mesh, paint)?;
+    let up = o.up.normalize_or(Vec3::Y);
+    let ground = if o.ground {
+        let lowest = mesh.positions().iter().map(|p| p.dot(up)).fold(f32::INFINITY, f32::min);
+        Some(ground_plane(center, radius, up, lowest).context("the ground plane")?)
+    } else {
+        None
+    };
+    let mut scene = SurfaceScene::builder().mesh(mesh, paint, Material::MATTE);
+    if let Some(g) = ground {
+        scene = scene.mesh(g, Paint::Solid(GROUND), Material::MATTE);
+    }
+    let world = scene.build()?;
     let built = t0.elapsed();
 
     let (w, h) = o.size;
@@ -166,14 +277,46 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let rendered = t1.elapsed();
 
-    let frame = renderer.frame()?;
+    let mut frame = renderer.frame()?;
+    if let Some((top, bottom)) = o.background.colors() {
+        over_background(&mut frame, top, bottom);
+    }
     let out = o.out.clone().unwrap_or_else(|| o.file.with_extension("png"));
     write_png(&frame, &out)?;
+    let mut written = out.display().to_string();
+    if o.figure {
+        let path = beside(&out, "figure");
+        let file = o
+            .file
+            .file_name()
+            .map_or(o.file.display().to_string(), |f| f.to_string_lossy().into_owned());
+        let (legend, subtitle) = match mapped {
+            Some((map, constant)) => {
+                let (lo, hi) = map.range();
+                let (lo, hi) = (significant(lo.into()), significant(hi.into()));
+                let range =
+                    if constant { format!("constant, {lo}") } else { format!("{lo} to {hi}") };
+                let legend = Legend::ColorBar { map, name: name.to_string(), constant };
+                let cmap = o.colormap.to_possible_value().map(|v| v.get_name().to_string());
+                let cmap = cmap.unwrap_or_default();
+                (legend, format!("coloured by {name} ({range}) through {cmap}"))
+            }
+            None => (Legend::None, String::new()),
+        };
+        let figure = Figure {
+            image: Image::from_frame(&frame),
+            title: format!("{file}: {triangles} triangles"),
+            subtitle,
+            axes: None,
+            legend,
+        };
+        figure.write(&path)?;
+        written = format!("{written}, {}", path.display());
+    }
     let c = renderer.counts();
     let seconds = rendered.as_secs_f64();
     println!(
-        "wrote {} ({w}×{h}, {triangles} triangles, {} passes; read + build {:.2} s, render {seconds:.2} s, {:.1} Mrays/s: {} primary, {} shadow, {} AO)",
-        out.display(),
+        "wrote {written} ({w}×{h}, {triangles} triangles, {} passes; read + build {:.2} s, render {seconds:.2} s, {:.1} Mrays/s: {} primary, {} shadow, {} AO)",
         o.passes,
         built.as_secs_f64(),
         c.total() as f64 / seconds / 1e6,

@@ -170,3 +170,160 @@ fn schlieren_renders_deterministically_with_its_exposure_printed() {
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A PNG's header and pixels (as stored: no expansion or stripping).
+fn decode(path: &Path) -> (png::OutputInfo, Vec<u8>) {
+    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file)).read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    buf.truncate(info.buffer_size());
+    (info, buf)
+}
+
+/// A unit square facing +z with two per-vertex scalars: `flat` exactly
+/// 2.5 everywhere, `temp` 300 and the next float up (one ulp apart).
+fn constant_scalar_ply(dir: &Path) -> PathBuf {
+    let path = dir.join("square.ply");
+    std::fs::write(
+        &path,
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+         property float z\nproperty float flat\nproperty float temp\nelement face 2\n\
+         property list uchar int vertex_indices\nend_header\n\
+         0 0 0 2.5 300\n1 0 0 2.5 300.00003\n1 1 0 2.5 300\n0 1 0 2.5 300.00003\n\
+         3 0 1 2\n3 0 2 3\n",
+    )
+    .unwrap();
+    path
+}
+
+/// A scalar without range (exactly constant, or within round-off) is
+/// drawn in one colour with a warning, not stretched over its round-off:
+/// every fully covered pixel of the flat, evenly lit square is the same.
+#[test]
+fn view_warns_about_a_constant_scalar_and_paints_it_in_one_colour() {
+    let dir = scratch("constant-scalar");
+    let ply = constant_scalar_ply(&dir);
+    for scalar in ["flat", "temp"] {
+        let out = dir.join(format!("{scalar}.png"));
+        let o = rt(&[
+            "view",
+            ply.to_str().unwrap(),
+            "--scalar",
+            scalar,
+            "--size",
+            "64x48",
+            "--background",
+            "transparent",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains(&format!("rt: warning: scalar {scalar} is constant (")), "{e}");
+        assert!(e.contains("drawn in one colour"), "{e}");
+        let (info, px) = decode(&out);
+        assert_eq!(info.color_type, png::ColorType::Rgba);
+        let inside: Vec<&[u8]> = px.chunks_exact(4).filter(|p| p[3] == 255).collect();
+        assert!(inside.len() > 100, "the square covers the view: {}", inside.len());
+        assert!(inside.iter().all(|p| *p == inside[0]), "{scalar}: more than one colour");
+    }
+    // A range given by the user is taken as it is: no warning.
+    let out = dir.join("ranged.png");
+    let args = ["--scalar", "flat", "--range", "0,5", "--size", "32x24", "--out"];
+    let o = rt(&[&["view", ply.to_str().unwrap()][..], &args, &[out.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Renders are opaque by default (composited on white); `--background
+/// transparent` keeps alpha 0 where nothing was hit.
+#[test]
+fn view_background_is_opaque_unless_transparent_is_asked_for() {
+    let dir = scratch("background");
+    let ply = constant_scalar_ply(&dir);
+    let render = |name: &str, extra: &[&str]| {
+        let out = dir.join(name);
+        let mut args = vec!["view", ply.to_str().unwrap(), "--size", "48x32"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--out", out.to_str().unwrap()]);
+        let o = rt(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        decode(&out).1
+    };
+    let opaque = render("default.png", &[]);
+    assert!(opaque.chunks_exact(4).all(|p| p[3] == 255));
+    assert_eq!(&opaque[..4], &[255; 4], "white in the corner");
+    for background in ["black", "gradient"] {
+        let px = render(&format!("{background}.png"), &["--background", background]);
+        assert!(px.chunks_exact(4).all(|p| p[3] == 255), "{background}");
+    }
+    let clear = render("clear.png", &["--background", "transparent"]);
+    assert_eq!(&clear[..4], &[0; 4], "nothing hit in the corner");
+    assert!(clear.chunks_exact(4).any(|p| p[3] == 255));
+    // Facets, a ground plane and a figure are accepted too.
+    let o = rt(&[
+        "view",
+        ply.to_str().unwrap(),
+        "--flat",
+        "--ground",
+        "--shadows",
+        "--figure",
+        "--size",
+        "48x32",
+        "--out",
+        dir.join("more.png").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(dir.join("more-figure.png").is_file());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `rt schlieren` writes the image, its figure beside it (unless
+/// `--no-figure`) and, with `--raw16`, a linear 16-bit PNG of the same
+/// size: grey, or RGB for the colour filter.
+#[test]
+fn schlieren_writes_a_figure_and_a_16_bit_image_on_request() {
+    let dir = scratch("figure");
+    let vol = bump_volume(&dir, false);
+    let run = |out: &Path, extra: &[&str]| {
+        let mut args = vec!["schlieren", vol.to_str().unwrap(), "--size", "40", "--photons", "4"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--out", out.to_str().unwrap()]);
+        let o = rt(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stdout(&o)
+    };
+    let said = run(&dir.join("knife.png"), &["--raw16"]);
+    let figure = dir.join("knife-figure.png");
+    assert!(said.contains(figure.to_str().unwrap()), "{said}");
+    let (image, _) = decode(&dir.join("knife.png"));
+    assert_eq!((image.width, image.height), (40, 40));
+    let (info, _) = decode(&figure);
+    assert!(info.width >= 520 && info.height >= 520, "{}×{}", info.width, info.height);
+    let (raw, px) = decode(&dir.join("knife-16bit.png"));
+    assert_eq!(raw.bit_depth, png::BitDepth::Sixteen);
+    assert_eq!(raw.color_type, png::ColorType::Grayscale);
+    assert_eq!((raw.width, raw.height), (40, 40));
+    // Near the corner the beam is undisturbed: a knife edge passes half
+    // the source there, 16384 (the mean of 4 × 4 pixels, one in from the
+    // edges).
+    let at = |x: usize, y: usize| {
+        f64::from(u16::from_be_bytes([px[2 * (x + 40 * y)], px[2 * (x + 40 * y) + 1]]))
+    };
+    let corner =
+        (1..5).flat_map(|y| (1..5).map(move |x| (x, y))).map(|(x, y)| at(x, y)).sum::<f64>() / 16.0;
+    assert!((15000.0..17800.0).contains(&corner), "{corner}");
+
+    run(&dir.join("color.png"), &["--cutoff", "color", "--raw16", "--no-figure"]);
+    assert!(dir.join("color.png").is_file());
+    assert!(!dir.join("color-figure.png").exists(), "--no-figure writes no figure");
+    let (raw, _) = decode(&dir.join("color-16bit.png"));
+    assert_eq!((raw.bit_depth, raw.color_type), (png::BitDepth::Sixteen, png::ColorType::Rgb));
+    // The last of --figure / --no-figure wins.
+    run(&dir.join("again.png"), &["--no-figure", "--figure"]);
+    assert!(dir.join("again-figure.png").is_file());
+    assert!(!dir.join("again-16bit.png").exists(), "no --raw16, no 16-bit image");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -135,17 +135,37 @@ pub struct Bench {
     pub width: f64,
     /// Beam height along v.
     pub height: f64,
-    /// Distance from the exit point to the film along the ray
-    /// (shadowgraph; 0 images the test section).
+    /// Distance along the beam from `center` to the plane the optics
+    /// image: the object's mid-plane, as a real schlieren or shadowgraph
+    /// set-up focuses on it.
+    pub image_plane: f64,
+    /// Distance from the image plane to the film along the beam
+    /// (shadowgraph; 0 images the mid-plane, negative values a plane
+    /// upstream of it). Each photon lands where its exit ray crosses that
+    /// plane.
     pub film_distance: f64,
     /// What is recorded.
     pub mode: Mode,
     /// Cutoff weighting.
     pub weighting: Weighting,
-    /// Photons per pixel per pass: `k × k` strata.
+    /// Photons per pixel per pass: `k × k`, placed by a low-discrepancy
+    /// sequence that each pass continues.
     pub strata: u32,
     /// Integrator settings.
     pub params: TraceParams,
+}
+
+/// The `n`-th point of the R2 sequence (Roberts 2018) in `[0, 1)²`,
+/// shifted by `shift` modulo 1.
+#[inline]
+fn r2(n: u64, shift: (f64, f64)) -> (f64, f64) {
+    // 1/φ₂ and 1/φ₂², φ₂ the plastic number (the real root of x³ = x + 1).
+    const A1: f64 = 0.754_877_666_246_692_8;
+    const A2: f64 = 0.569_840_290_998_053_3;
+    // n·α mod 1 in two steps, exact enough for n < 2⁵³.
+    let frac = |x: f64| x - math::floor(x);
+    let n = n as f64;
+    (frac(shift.0 + frac(n * A1)), frac(shift.1 + frac(n * A2)))
 }
 
 impl Bench {
@@ -170,8 +190,8 @@ impl Bench {
         if !(positive(self.width) && positive(self.height)) {
             return Err(BenchError::BeamSize { width: self.width, height: self.height });
         }
-        if !(self.film_distance.is_finite()) {
-            return Err(BenchError::FilmDistance(self.film_distance));
+        if !(self.film_distance.is_finite() && self.image_plane.is_finite()) {
+            return Err(BenchError::FilmDistance(self.film_distance + self.image_plane));
         }
         if !(1..=64).contains(&self.strata) {
             return Err(BenchError::Strata(self.strata));
@@ -204,27 +224,38 @@ impl Bench {
         let (w, h) = (film.width(), film.height());
         let k = self.strata as usize;
         let mut rng = rng_for(seed ^ pass.wrapping_mul(0x9e37_79b9_7f4a_7c15), row as u64);
+        // Each pixel is split into `k × k` strata, one photon in each per
+        // pass; within a stratum, the passes place their photons along a
+        // low-discrepancy R2 sequence (Roberts 2018: `nα mod 1`, α from the
+        // plastic number) shifted by a random offset per stratum
+        // (Cranley–Patterson). Pass 0 is plain jittered stratification; the
+        // later passes fill the gaps it left, so noise falls faster than
+        // `1/√passes`. The offsets do not depend on the pass.
+        let mut offsets = rng_for(seed ^ 0x6a09_e667_f3bc_c909, row as u64);
         let mut out = Vec::with_capacity(w * k * k);
         let v = self.v();
         let cutoff = match &self.mode {
             Mode::Schlieren(c) => Some(c.prepare()),
             Mode::Interferometry { .. } => None,
         };
+        let film_plane = self.image_plane + self.film_distance;
         for i in 0..w {
             for s in 0..k * k {
-                // Stratified and jittered inside the pixel's footprint.
-                let (sx, sy) = ((s % k) as f64, (s / k) as f64);
-                let px = i as f64 + (sx + uniform(&mut rng) as f64) / k as f64;
-                let py = row as f64 + (sy + uniform(&mut rng) as f64) / k as f64;
+                let shift = (f64::from(uniform(&mut offsets)), f64::from(uniform(&mut offsets)));
+                let (rx, ry) = r2(pass, shift);
+                let (jx, jy) = (((s % k) as f64 + rx) / k as f64, ((s / k) as f64 + ry) / k as f64);
+                let px = i as f64 + jx;
+                let py = row as f64 + jy;
                 let a = (px / w as f64 - 0.5) * self.width;
                 let b = (0.5 - py / h as f64) * self.height;
                 let o = self.center + a * self.u + b * v;
                 let (r, colour) = tracer(o, self.direction).map_err(BenchError::Trace)?;
                 let e = r.direction;
                 let (eu, ev) = (e.dot(self.u), e.dot(v));
-                // Exit point carried L further along the ray, on the film plane.
+                // The exit ray carried (forward or back) to the film plane.
                 let along = e.dot(self.direction).max(1e-12);
-                let p = r.position + (self.film_distance / along) * e;
+                let to_film = film_plane - (r.position - self.center).dot(self.direction);
+                let p = r.position + (to_film / along) * e;
                 let fa = (p - self.center).dot(self.u);
                 let fb = (p - self.center).dot(v);
                 let fx = (fa / self.width + 0.5) * w as f64;

@@ -43,7 +43,8 @@
 //!     u: DVec3::X,
 //!     width: 6.0,
 //!     height: 6.0,
-//!     film_distance: 0.0, // image the test section (no shadowgraph)
+//!     image_plane: 6.0,   // the bump's mid-plane, z = 0
+//!     film_distance: 0.0, // image it (no shadowgraph)
 //!     // f/h = 1500: a deflection of 1/3000 rad changes the image by 0.5.
 //!     mode: Mode::Schlieren(Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.5, h: 1e-3 }),
 //!     weighting: Weighting::Weight,

@@ -69,6 +69,66 @@ impl Mesh {
         Ok(self)
     }
 
+    /// The mesh with angle-weighted smooth vertex normals (Thürmer & Wüthrich
+    /// 1998), replacing any: each vertex normal is `Σ αᵢ n̂ᵢ`, normalised,
+    /// over the triangles `i` that use the vertex, `αᵢ` the triangle's angle
+    /// at the vertex and `n̂ᵢ` its unit geometric normal. Unlike area or
+    /// plain averages, the result does not change when a face is split into
+    /// more triangles, and a flat region gets exactly its plane's normal
+    /// (exactly: an axis-aligned plane gives `±1` and zeros). On a curved
+    /// surface it tends to the surface's normal as the triangles shrink:
+    /// to first order in the edge length where a vertex's ring is
+    /// irregular (on a subdivided icosphere, 0.01 rad at 320 triangles,
+    /// halving with each subdivision).
+    ///
+    /// Degenerate triangles (zero area, or so large their edges overflow)
+    /// contribute nothing. A vertex whose sum cannot be normalised keeps
+    /// a usable normal instead:
+    /// - the sum cancels (a vertex of two faces back to back): the normal
+    ///   of its first valid triangle, in index order;
+    /// - it has no valid triangle (unused, or only on degenerate
+    ///   triangles, which rays never hit): the normal the mesh had there,
+    ///   or `+Z` without one. No hit interpolates such a vertex's normal.
+    ///
+    /// Sums are accumulated in `f64`; angles are `acos` of unit edges'
+    /// dot products (glam's `angle_between`, accurate to ~1e-6 rad).
+    #[must_use]
+    pub fn with_smooth_normals(mut self) -> Self {
+        let positions = self.geometry.positions();
+        let mut sums = alloc::vec![glam::DVec3::ZERO; positions.len()];
+        let mut first: Vec<Option<Vec3>> = alloc::vec![None; positions.len()];
+        for t in self.geometry.indices() {
+            let v = t.map(|i| positions[i as usize]);
+            // Unit edges leaving each corner: 0→1, 1→2, 2→0.
+            let (Some(e01), Some(e12), Some(e20)) =
+                (unit(v[1] - v[0]), unit(v[2] - v[1]), unit(v[0] - v[2]))
+            else {
+                continue;
+            };
+            // `(v1 − v0) × (v2 − v0)`, the geometric normal's direction.
+            let Some(n) = unit(e01.cross(-e20)) else { continue };
+            let angles =
+                [e01.angle_between(-e20), e12.angle_between(-e01), e20.angle_between(-e12)];
+            for (&i, a) in t.iter().zip(angles) {
+                if a.is_finite() {
+                    sums[i as usize] += n.as_dvec3() * f64::from(a);
+                }
+                first[i as usize].get_or_insert(n);
+            }
+        }
+        let old = self.normals.take();
+        let normals = sums
+            .iter()
+            .zip(&first)
+            .enumerate()
+            .map(|(i, (s, f))| {
+                unit(s.as_vec3()).or(*f).or_else(|| old.as_ref().map(|o| o[i])).unwrap_or(Vec3::Z)
+            })
+            .collect();
+        self.normals = Some(normals);
+        self
+    }
+
     /// The geometry alone (positions and triangles).
     #[must_use]
     pub fn geometry(&self) -> &TriangleMesh {
@@ -136,6 +196,14 @@ impl Mesh {
         });
         interpolated.unwrap_or(hit.normal)
     }
+}
+
+/// `v` scaled to unit length, or `None` for a zero or non-finite `v`.
+/// Scaled by its largest component first, so no length overflows or
+/// underflows, and an axis-aligned `v` becomes exactly `±1` and zeros.
+fn unit(v: Vec3) -> Option<Vec3> {
+    let m = v.abs().max_element();
+    if m > 0.0 && m.is_finite() { (v / m).try_normalize() } else { None }
 }
 
 impl From<TriangleMesh> for Mesh {

@@ -178,6 +178,7 @@ pub fn schlieren(delta: f64, eps: f64) -> f64 {
         u: DVec3::X,
         width: 6.0,
         height: 6.0,
+        image_plane: 6.0,
         film_distance: 0.0,
         mode: Mode::Schlieren(edge.clone()),
         weighting: Weighting::Weight,

@@ -8,10 +8,11 @@
 //! - `surface.png`: a ray-traced scientific surface scene rendered with
 //!   `rt_surface::Renderer`: a terrain mesh coloured by its height through
 //!   viridis (the scalar is interpolated across each triangle, then
-//!   mapped), slightly mirroring sphere glyphs coloured with the
-//!   cool-to-warm map, and a glossy streamline tube, under ambient light
-//!   with ambient occlusion (8 rays) and a directional light with hard
-//!   shadows; 4 progressive passes.
+//!   mapped; angle-weighted smooth vertex normals), slightly mirroring
+//!   sphere glyphs coloured with the cool-to-warm map, and a glossy
+//!   streamline tube, under ambient light with ambient occlusion (8 rays)
+//!   and a directional light with hard shadows; 4 progressive passes, on
+//!   white (as `rt view` draws by default).
 //! - `terrain.ply`: the terrain mesh with its `height` scalar, to try the
 //!   `rt view` on (`--scalar height`).
 //! - From the built-in blast wave (`rt-cli/data/`, a real PyClaw Euler
@@ -20,8 +21,12 @@
 //!   background mid-grey), `shadowgraph.png` (film 2 m behind, background
 //!   mid-grey), `interferogram.png` (10.6 µm CO₂ laser, finite fringes) and
 //!   `schlieren-color.png` (hue-wheel colour filter: hue = direction of
-//!   deflection, saturation = its size).
+//!   deflection, saturation = its size), each with its `-figure.png`
+//!   (axes in metres, scale bar, the optics in the title, the colour
+//!   filter's legend) as `rt schlieren` writes it.
 mod optics;
+
+pub use optics::blast_wave;
 
 use std::{path::PathBuf, time::Instant};
 
@@ -31,7 +36,10 @@ use rt_surface::{
     Glyphs, Light, Material, Mesh, Paint, Renderer, Settings, SurfaceScene, Tube, io::write_ply,
 };
 
-use crate::{image::write_png, scenes};
+use crate::{
+    image::{over_background, write_png},
+    scenes,
+};
 
 /// `rt demo [DIR]`: options.
 #[derive(Debug, clap::Args)]
@@ -108,7 +116,9 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     write_ply(&mesh, "height", std::io::BufWriter::new(file))
         .with_context(|| ply.display().to_string())?;
     let t0 = Instant::now();
-    let world = build_world(mesh)?;
+    // Smooth shading for the render; the file keeps plain geometry (`rt
+    // view` computes the same normals).
+    let world = build_world(mesh.with_smooth_normals())?;
     let built = t0.elapsed();
     let proj = Projection::Perspective { fov_y: 40f32.to_radians() };
     let cam = Camera::look_at(
@@ -136,7 +146,8 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         renderer.render_pass(&world);
     }
     let rendered = t1.elapsed();
-    let frame = renderer.frame()?;
+    let mut frame = renderer.frame()?;
+    over_background(&mut frame, [1.0; 3], [1.0; 3]);
     let c = renderer.counts();
     let path = out.join("surface.png");
     write_png(&frame, &path)?;

@@ -4,8 +4,8 @@
 use rt_photo::glam::DVec3;
 use rt_photo::{Bench, Cutoff, Mode, TraceParams, Weighting};
 
-/// A beam along +z over `[-3, 3]²`, emitted at z = −6, imaging the test
-/// section (`L = 0`), `strata²` photons per pixel, weighted.
+/// A beam along +z over `[-3, 3]²`, emitted at z = −6, imaging the plane
+/// z = 0 (`L = 0`), `strata²` photons per pixel, weighted.
 pub(crate) fn bench(mode: Mode, strata: u32) -> Bench {
     Bench {
         center: DVec3::new(0.0, 0.0, -6.0),
@@ -13,6 +13,7 @@ pub(crate) fn bench(mode: Mode, strata: u32) -> Bench {
         u: DVec3::X,
         width: 6.0,
         height: 6.0,
+        image_plane: 6.0,
         film_distance: 0.0,
         mode,
         weighting: Weighting::Weight,

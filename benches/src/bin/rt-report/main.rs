@@ -6,6 +6,7 @@
 //! cargo run --release -p rt-benches --bin rt-report -- grin [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- octree [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- schlieren [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- noise [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- render [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- composite [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- all [--quick]   # + index.md
@@ -17,6 +18,7 @@ mod composite;
 #[cfg(feature = "embree3")]
 mod embree3;
 mod grin;
+mod noise;
 mod octree;
 mod render;
 mod schlieren;
@@ -102,7 +104,7 @@ fn main() -> ExitCode {
         args.iter().filter(|a| !a.starts_with("--")).map(String::as_str).collect();
     let all = areas.is_empty() || areas == ["all"];
     let areas = if all {
-        vec!["traversal", "grin", "octree", "schlieren", "render", "composite"]
+        vec!["traversal", "grin", "octree", "schlieren", "noise", "render", "composite"]
     } else {
         areas
     };
@@ -118,10 +120,11 @@ fn main() -> ExitCode {
             "grin" => grin::run(&dir, quick),
             "octree" => octree::run(&dir, quick),
             "schlieren" => schlieren::run(&dir, quick),
+            "noise" => noise::run(&dir, quick),
             "render" => render::run(&dir, quick),
             "composite" => composite::run(&dir, quick),
             other => Err(format!(
-                "unknown area `{other}` (known: traversal, grin, octree, schlieren, render, composite, all)"
+                "unknown area `{other}` (known: traversal, grin, octree, schlieren, noise, render, composite, all)"
             )),
         };
         match result {
