@@ -340,3 +340,18 @@ fn ply_round_trip() {
         assert_eq!(e.kind(), std::io::ErrorKind::InvalidInput, "{bad:?}");
     }
 }
+
+/// OBJ errors say which line (tobj's own errors do not).
+#[test]
+fn obj_errors_name_the_line() {
+    for (obj, line) in [
+        (&b"v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n"[..], 2),
+        (b"# a comment\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0\nf 1 2 3\n", 5),
+        (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 x\n", 5),
+        (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n", 5),
+    ] {
+        let e = parse_obj(obj).unwrap_err();
+        assert!(e.to_string().contains(&format!("OBJ line {line}: ")), "{e}");
+        assert_eq!(e.to_string().lines().count(), 1);
+    }
+}
