@@ -298,25 +298,54 @@ impl Grid {
         };
         let (wx, wy, wz) = (w(f[0]), w(f[1]), w(f[2]));
         let (dx, dy, dz) = (dw(f[0]), dw(f[1]), dw(f[2]));
-        let (mut v, mut g) = (0.0, DVec3::ZERO);
-        for k in 0..4 {
-            for j in 0..4 {
-                for i in 0..4 {
-                    let s = self.at([
-                        b[0] + i as isize - 1,
-                        b[1] + j as isize - 1,
-                        b[2] + k as isize - 1,
-                    ]);
-                    v += wx[i] * wy[j] * wz[k] * s;
-                    g += s * DVec3::new(
-                        dx[i] * wy[j] * wz[k],
-                        wx[i] * dy[j] * wz[k],
-                        wx[i] * wy[j] * dz[k],
-                    );
+        let [nx, ny, nz] = self.dims.map(|n| n as isize);
+        let inside =
+            b[0] >= 1 && b[1] >= 1 && b[2] >= 1 && b[0] + 2 < nx && b[1] + 2 < ny && b[2] + 2 < nz;
+        // The 4³ stencil: straight from the data inside the grid, through
+        // the ghost-sample rule next to a face.
+        let mut s = [[[0.0f64; 4]; 4]; 4];
+        if inside {
+            let (sy, sz) = (self.dims[0], self.dims[0] * self.dims[1]);
+            let base = (b[0] - 1) as usize + sy * (b[1] - 1) as usize + sz * (b[2] - 1) as usize;
+            for (k, plane) in s.iter_mut().enumerate() {
+                for (j, row) in plane.iter_mut().enumerate() {
+                    let r = base + j * sy + k * sz;
+                    for (i, v) in row.iter_mut().enumerate() {
+                        *v = f64::from(self.data[r + i]);
+                    }
+                }
+            }
+        } else {
+            for (k, plane) in s.iter_mut().enumerate() {
+                for (j, row) in plane.iter_mut().enumerate() {
+                    for (i, v) in row.iter_mut().enumerate() {
+                        *v = self.at([
+                            b[0] + i as isize - 1,
+                            b[1] + j as isize - 1,
+                            b[2] + k as isize - 1,
+                        ]);
+                    }
                 }
             }
         }
-        (v, g)
+        // Separable: contract along x (value and x-derivative per row),
+        // then y, then z — 4³ samples in ~200 flops instead of ~700.
+        let dot =
+            |w: &[f64; 4], v: &[f64; 4]| w[0] * v[0] + w[1] * v[1] + w[2] * v[2] + w[3] * v[3];
+        let (mut v, mut gx, mut gy, mut gz) = (0.0, 0.0, 0.0, 0.0);
+        for (k, plane) in s.iter().enumerate() {
+            let (mut a, mut ax) = ([0.0; 4], [0.0; 4]);
+            for (j, row) in plane.iter().enumerate() {
+                a[j] = dot(&wx, row);
+                ax[j] = dot(&dx, row);
+            }
+            let (c, cy, cx) = (dot(&wy, &a), dot(&dy, &a), dot(&wy, &ax));
+            v += wz[k] * c;
+            gz += dz[k] * c;
+            gy += wz[k] * cy;
+            gx += wz[k] * cx;
+        }
+        (v, DVec3::new(gx, gy, gz))
     }
 }
 
@@ -450,6 +479,71 @@ mod tests {
                 "axis {a}: {fd} vs {}",
                 grad[a]
             );
+        }
+    }
+
+    /// The separable evaluation (fast path inside, ghost samples next to
+    /// the faces) equals the plain 4³ sum of weights times samples, and
+    /// its gradient the central difference of its value, everywhere.
+    #[test]
+    #[allow(clippy::needless_range_loop, reason = "the reference sum reads as the formula")]
+    fn catmull_rom_equals_the_plain_stencil_sum_everywhere() {
+        let data: Vec<f32> = (0..7 * 6 * 5).map(|i| ((i as f32) * 0.61).sin() + 2.0).collect();
+        let g = Grid::new([7, 6, 5], DVec3::new(0.1, -0.2, 0.3), DVec3::new(0.1, 0.2, 0.15), data)
+            .unwrap();
+        let w = |t: f64| {
+            let (t2, t3) = (t * t, t * t * t);
+            [
+                0.5 * (-t3 + 2.0 * t2 - t),
+                0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
+                0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+                0.5 * (t3 - t2),
+            ]
+        };
+        for n in 0..400 {
+            let t = f64::from(n);
+            // Sample coordinates over the whole grid, faces included.
+            let u = DVec3::new(
+                (0.37 * t).fract() * 6.0,
+                (0.71 * t).fract() * 5.0,
+                (0.13 * t + 0.05).fract() * 4.0,
+            );
+            let x = g.origin + u * g.spacing;
+            let (v, grad) = g.sample(x, Interp::CatmullRom);
+            let b = u.to_array().map(|c| (c.floor() as isize).min(5));
+            let b = [b[0].min(5), b[1].min(4), b[2].min(3)];
+            let f = [0, 1, 2].map(|a| u[a] - b[a] as f64);
+            let (wx, wy, wz) = (w(f[0]), w(f[1]), w(f[2]));
+            let mut want = 0.0;
+            for k in 0..4 {
+                for j in 0..4 {
+                    for i in 0..4 {
+                        let idx =
+                            [b[0] + i as isize - 1, b[1] + j as isize - 1, b[2] + k as isize - 1];
+                        want += wx[i] * wy[j] * wz[k] * g.at(idx);
+                    }
+                }
+            }
+            assert!((v - want).abs() < 1e-12, "{u}: {v} vs {want}");
+            let e = 1e-7;
+            for a in 0..3 {
+                let mut d = DVec3::ZERO;
+                d[a] = e;
+                // Within half a cell of a face the slope is flat by design.
+                let du = e / g.spacing[a];
+                let hi = (g.dims[a] - 1) as f64;
+                if u[a] - du < 0.0 || u[a] + du > hi {
+                    continue;
+                }
+                let fd = (g.sample(x + d, Interp::CatmullRom).0
+                    - g.sample(x - d, Interp::CatmullRom).0)
+                    / (2.0 * e);
+                assert!(
+                    (fd - grad[a]).abs() < 1e-4 * (1.0 + fd.abs()),
+                    "{u} axis {a}: {fd} vs {}",
+                    grad[a]
+                );
+            }
         }
     }
 

@@ -7,8 +7,9 @@
 //!   and its gradient component along axis `a` by the largest corner
 //!   difference along `a` divided by the spacing;
 //! - the **Catmull–Rom** interpolant `f = Σ wᵢ(tx) wⱼ(ty) wₖ(tz) pᵢⱼₖ` reads
-//!   the 4³ samples `i−1 … i+2` (indices clamped at the faces, as the
-//!   sampler does). Its weights sum to 1 with `Σ|wᵢ(t)| ≤ W = 5/4` (at
+//!   the 4³ samples `i−1 … i+2`, with one layer of ghost samples outside
+//!   the grid extrapolated linearly (`s₋₁ = 2s₀ − s₁`) as the sampler
+//!   does; the bounds below run over that extended grid. Its weights sum to 1 with `Σ|wᵢ(t)| ≤ W = 5/4` (at
 //!   `t = ½`), so `f` lies within the samples' range widened by
 //!   `(W³ − 1)/2 = 0.4765625` of it. Summing by parts, `∂f/∂x · h =
 //!   Σⱼₖ wⱼ wₖ Σₘ cₘ(tx) Δₘ` over the three differences `Δₘ = p_{m+1} − p_m`
@@ -372,48 +373,88 @@ fn for_each_cell(cells: [usize; 3], mut f: impl FnMut([usize; 3])) {
     }
 }
 
-/// Per-sample maxima and minima over the Catmull–Rom neighbourhoods,
+/// Per-cell maxima and minima over the Catmull–Rom neighbourhoods,
 /// computed separably (three passes of a sliding window per axis) so a
-/// cell costs a few lookups, not 4³.
+/// cell costs a few lookups, not 4³. They run over the grid extended by
+/// the sampler's ghost layer, so the cell with lower corner `(i, j, k)`
+/// reads extended samples `i … i+3` (sample `i − 1` is extended `i`).
 struct Windows {
-    dims: [usize; 3],
-    /// Samples' min and max over offsets `−1 … 2` on every axis.
+    /// The extended grid's dimensions (`dims + 2`).
+    ext: [usize; 3],
+    /// Samples' min and max over extended offsets `0 … 3` on every axis.
     lo: Vec<f32>,
     hi: Vec<f32>,
     /// Per axis `a`: `max |Δ|` of the differences along `a` that a cell's
-    /// interpolant reads (pairs `−1 … 1` along `a`, samples `−1 … 2`
-    /// across it).
+    /// interpolant reads (pairs `0 … 2` along `a`, samples `0 … 3` across
+    /// it, in extended offsets).
     diff: [Vec<f32>; 3],
 }
 
 impl Windows {
     fn new(dims: [usize; 3], samples: &[f32]) -> Self {
-        let lo = window(dims, samples.to_vec(), [(-1, 2); 3], f32::min);
-        let hi = window(dims, samples.to_vec(), [(-1, 2); 3], f32::max);
+        let ext = dims.map(|n| n + 2);
+        let e = extend(dims, samples);
+        let lo = window(ext, e.clone(), [(0, 3); 3], f32::min);
+        let hi = window(ext, e.clone(), [(0, 3); 3], f32::max);
         let diff = [0, 1, 2].map(|a| {
-            // |p(x + eₐ) − p(x)| at each sample, 0 on the last one (its pair
-            // would clamp onto itself).
-            let stride = [1, dims[0], dims[0] * dims[1]][a];
-            let mut d = alloc::vec![0.0f32; samples.len()];
+            // |p(x + eₐ) − p(x)| at each extended sample, 0 on the last.
+            let stride = [1, ext[0], ext[0] * ext[1]][a];
+            let mut d = alloc::vec![0.0f32; e.len()];
             for (idx, v) in d.iter_mut().enumerate() {
-                let c = [idx % dims[0], (idx / dims[0]) % dims[1], idx / (dims[0] * dims[1])];
-                if c[a] + 1 < dims[a] {
-                    *v = (samples[idx + stride] - samples[idx]).abs();
+                let c = [idx % ext[0], (idx / ext[0]) % ext[1], idx / (ext[0] * ext[1])];
+                if c[a] + 1 < ext[a] {
+                    *v = (e[idx + stride] - e[idx]).abs();
                 }
             }
-            let mut reach = [(-1, 2); 3];
-            reach[a] = (-1, 1);
-            window(dims, d, reach, f32::max)
+            let mut reach = [(0, 3); 3];
+            reach[a] = (0, 2);
+            window(ext, d, reach, f32::max)
         });
-        Self { dims, lo, hi, diff }
+        Self { ext, lo, hi, diff }
     }
 
-    /// `(min, max, max |Δ| per axis)` over dual cell `(i, j, k)`'s
-    /// neighbourhood.
+    /// `(min, max, max |Δ| per axis)` over the neighbourhood of the dual
+    /// cell with lower corner `(i, j, k)`.
     fn cell(&self, i: usize, j: usize, k: usize) -> (f32, f32, [f32; 3]) {
-        let idx = i + self.dims[0] * (j + self.dims[1] * k);
+        let idx = i + self.ext[0] * (j + self.ext[1] * k);
         (self.lo[idx], self.hi[idx], [self.diff[0][idx], self.diff[1][idx], self.diff[2][idx]])
     }
+}
+
+/// The samples with one ghost layer on every side, extrapolated linearly
+/// one axis after another (`s₋₁ = 2s₀ − s₁`, `s_n = 2s_{n−1} − s_{n−2}`;
+/// a one-sample axis repeats its sample), as the grid's sampler does.
+fn extend(dims: [usize; 3], samples: &[f32]) -> Vec<f32> {
+    let ext = dims.map(|n| n + 2);
+    let mut e = alloc::vec![0.0f32; ext[0] * ext[1] * ext[2]];
+    let at = |i: usize, j: usize, k: usize| i + ext[0] * (j + ext[1] * k);
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                e[at(i + 1, j + 1, k + 1)] = samples[i + dims[0] * (j + dims[1] * k)];
+            }
+        }
+    }
+    // Along each axis in turn, over the lines already filled.
+    for a in 0..3 {
+        let n = dims[a];
+        let stride = [1, ext[0], ext[0] * ext[1]][a];
+        for idx in 0..e.len() {
+            let c = [idx % ext[0], (idx / ext[0]) % ext[1], idx / (ext[0] * ext[1])];
+            // Lines start at extended index 0 on axis `a`; the axes done
+            // before are filled everywhere, the ones after only inside.
+            let inside = (0..3).all(|b| b <= a || (1..=dims[b]).contains(&c[b]));
+            if c[a] != 0 || !inside {
+                continue;
+            }
+            let s = |t: usize| e[idx + t * stride];
+            let (first, last) =
+                if n < 2 { (s(1), s(n)) } else { (2.0 * s(1) - s(2), 2.0 * s(n) - s(n - 1)) };
+            e[idx] = first;
+            e[idx + (n + 1) * stride] = last;
+        }
+    }
+    e
 }
 
 /// `data` with each value replaced by `pick` over the window
@@ -536,8 +577,15 @@ mod tests {
                 let origin = glam::DVec3::new(-1.0, 0.5, 2.0);
                 let grid = crate::Grid::new(dims, origin, spacing.into(), data.clone()).unwrap();
                 let tree = Octree::build_for(interp, dims, &data, spacing).unwrap();
-                for _ in 0..2000 {
-                    let p = [0, 1, 2].map(|a| next() * (dims[a] - 1) as f64);
+                for n in 0..4000 {
+                    // Half the points in the cells next to a face, where
+                    // the sampler's ghost samples enter the stencil.
+                    let mut p = [0, 1, 2].map(|a| next() * (dims[a] - 1) as f64);
+                    if n % 2 == 0 {
+                        let a = n / 2 % 3;
+                        let hi = (dims[a] - 1) as f64;
+                        p[a] = if next() < 0.5 { next() } else { hi - next() };
+                    }
                     let b = tree.brick_of(p).unwrap();
                     let node = tree.levels[0][b[0] + tree.side * (b[1] + tree.side * b[2])];
                     let x = origin + glam::DVec3::from(p) * glam::DVec3::from(spacing);
