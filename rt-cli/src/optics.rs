@@ -140,8 +140,16 @@ impl Volume {
             mode,
             weighting: Weighting::Weight,
             strata: 1,
-            params: TraceParams::for_grid(&self.field),
+            params: self.params(),
         }
+    }
+
+    /// The integrator: leapfrog with steps of two cells, the report's
+    /// `rt-2voxel` setting, which reaches the same image error as one-cell
+    /// steps 1.3× faster (`rt-report schlieren`).
+    fn params(&self) -> TraceParams {
+        let base = TraceParams::for_grid(&self.field);
+        TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base }
     }
 
     /// One pass of the bench (`strata²` photons per pixel) onto `film`, on
