@@ -26,7 +26,7 @@
 //!   filter's legend) as `rt schlieren` writes it.
 mod optics;
 
-pub use optics::blast_wave;
+pub use optics::{blast_wave, blast_wave_with};
 
 use std::{path::PathBuf, time::Instant};
 

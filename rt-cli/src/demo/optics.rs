@@ -21,9 +21,17 @@ const JSON: &str = include_str!("../../data/blast_sedov_64.json");
 /// # Errors
 /// None in practice (the data are built in and valid).
 pub fn blast_wave() -> anyhow::Result<Volume> {
+    blast_wave_with(Interpolation::Cubic)
+}
+
+/// [`blast_wave`] with the interpolant `interp`.
+///
+/// # Errors
+/// None in practice (the data are built in and valid).
+pub fn blast_wave_with(interp: Interpolation) -> anyhow::Result<Volume> {
     let header: serde_json::Value = serde_json::from_str(JSON).context("built-in JSON header")?;
     let grid = io::parse_raw_json(&header, RAW).context("built-in blast wave")?;
-    Volume::density(grid, Interpolation::Cubic)
+    Volume::density(grid, interp)
 }
 
 /// Renders the four optical pictures into `out`.

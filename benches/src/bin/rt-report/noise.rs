@@ -14,7 +14,7 @@ use rt_benches::{
     plot::{Plot, Series, loglog},
     scenes::{knife_bench, sparse_bumps},
 };
-use rt_cli::{demo::blast_wave, schlieren};
+use rt_cli::{demo::blast_wave_with, schlieren};
 use rt_photo::{Film, Filter, TraceParams, build_octree};
 
 use crate::{
@@ -39,10 +39,11 @@ fn noise(a: &Film, b: &Film, disturbed: &[bool]) -> (f64, f64) {
 }
 
 pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
-    let volume = blast_wave().map_err(|e| e.to_string())?;
-    // The tool's defaults: knife edge, 512 px, 16 photons per pixel.
+    // The tool's defaults: knife edge, 512 px, 16 photons per pixel, its
+    // default interpolant.
     let defaults = schlieren::Args::from_args(Path::new("built-in"), ["--cutoff", "knife"])
         .map_err(|e| e.to_string())?;
+    let volume = blast_wave_with(defaults.interp).map_err(|e| e.to_string())?;
     let (bench, chosen) = schlieren::prepare(&volume, &defaults).map_err(|e| e.to_string())?;
     let size = if quick { 128 } else { defaults.size as usize };
     let counts: &[u32] = if quick { &[4, 16, 64] } else { &[4, 16, 64, 256] };
@@ -56,8 +57,9 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
 
     let mut csv = String::from("photons_per_pixel,photons,seconds,noise_disturbed,noise_all\n");
     let mut md = format!(
-        "Knife edge as `rt schlieren` chooses it ({chosen}), the built-in blast wave (Catmull–Rom, octree skipping and beam masks), {size}² pixels; {:.0} % of them disturbed.\n\n\
+        "Knife edge as `rt schlieren` chooses it ({chosen}), the built-in blast wave ({:?} interpolation, octree skipping and beam masks, leapfrog at two cells), {size}² pixels; {:.0} % of them disturbed.\n\n\
          | photons/pixel | photons | seconds | M photons/s | noise (disturbed) | × √N | noise (all) |\n|---|---|---|---|---|---|---|\n",
+        defaults.interp,
         100.0 * share
     );
     let mut rows = Vec::new();
