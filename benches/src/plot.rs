@@ -6,19 +6,12 @@
 //! licence is `assets/DejaVuSans-LICENSE`) and rasterised by `ab_glyph`, so
 //! no system font library is needed. The PNG is written with `png`.
 
-use std::{fmt, fs::File, io::BufWriter, ops::Range, path::Path, sync::OnceLock};
+use std::{fmt, fs::File, io::BufWriter, ops::Range, path::Path};
 
-use plotters::{
-    backend::DrawingBackend, drawing::DrawingAreaErrorKind, prelude::*, style::register_font,
-};
+use plotters::{backend::DrawingBackend, drawing::DrawingAreaErrorKind, prelude::*};
+use rt_cli::text::{FAMILY, register_font_once, superscript};
 
 use crate::image::WriteError;
-
-/// The plot's font: DejaVu Sans 2.37 from Debian's `fonts-dejavu-core`.
-static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-
-/// The family name the font is registered under (plotters' default).
-const FAMILY: &str = "sans-serif";
 
 /// The smallest and largest width or height, in pixels: below the smallest
 /// the axis texts do not fit.
@@ -232,12 +225,7 @@ pub fn loglog(plot: &Plot, width: u32, height: u32, path: &Path) -> Result<(), P
 
 /// Registers the embedded font with plotters once per process.
 fn register() -> Result<(), PlotError> {
-    static OK: OnceLock<bool> = OnceLock::new();
-    if *OK.get_or_init(|| register_font(FAMILY, FontStyle::Normal, FONT).is_ok()) {
-        Ok(())
-    } else {
-        Err(PlotError::Font)
-    }
+    if register_font_once() { Ok(()) } else { Err(PlotError::Font) }
 }
 
 #[inline]
@@ -314,25 +302,6 @@ fn tick_label(v: f64, plain: bool) -> String {
     } else {
         format!("{m}×10{}", superscript(e))
     }
-}
-
-fn superscript(e: i32) -> String {
-    e.to_string()
-        .chars()
-        .map(|c| match c {
-            '-' => '⁻',
-            '0' => '⁰',
-            '1' => '¹',
-            '2' => '²',
-            '3' => '³',
-            '4' => '⁴',
-            '5' => '⁵',
-            '6' => '⁶',
-            '7' => '⁷',
-            '8' => '⁸',
-            _ => '⁹',
-        })
-        .collect()
 }
 
 /// Series `i`'s marker, as pixel offsets around the point: circle,

@@ -14,7 +14,7 @@
 //! `assets/DejaVuSans-LICENSE`) and rasterised by `ab_glyph`: no system
 //! font library is needed.
 
-use std::{fmt, ops::Range, path::Path, sync::OnceLock};
+use std::{fmt, ops::Range, path::Path};
 
 use plotters::{
     coord::{
@@ -22,21 +22,15 @@ use plotters::{
         ranged1d::{DefaultFormatting, KeyPointHint},
     },
     prelude::*,
-    style::{
-        register_font,
-        text_anchor::{HPos, Pos, VPos},
-    },
+    style::text_anchor::{HPos, Pos, VPos},
 };
 use rt_core::{ColorMap, Frame, frame::linear_to_srgb};
 use rt_photo::FilterImage;
 
-use crate::image::{WriteError, over_background, write_rgb8};
-
-/// DejaVu Sans 2.37 (Debian's `fonts-dejavu-core`).
-static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-
-/// The family the font is registered under (plotters' default).
-const FAMILY: &str = "sans-serif";
+use crate::{
+    image::{WriteError, over_background, write_rgb8},
+    text::{FAMILY, register_font_once, superscript},
+};
 
 /// The image's longer side on the figure, in pixels.
 const SHOWN: Range<u32> = 520..1001;
@@ -192,12 +186,7 @@ pub(crate) struct Figure {
 
 /// Registers the embedded font with plotters once per process.
 fn register() -> Result<(), FigureError> {
-    static OK: OnceLock<bool> = OnceLock::new();
-    if *OK.get_or_init(|| register_font(FAMILY, FontStyle::Normal, FONT).is_ok()) {
-        Ok(())
-    } else {
-        Err(FigureError::Font)
-    }
+    if register_font_once() { Ok(()) } else { Err(FigureError::Font) }
 }
 
 /// Margins around the image: left, right, top, bottom (the axes' ticks
@@ -624,25 +613,6 @@ fn scientific(x: f64) -> String {
     }
     let e = (x.abs().log10() + 1e-9).floor() as i32;
     format!("{:.1}×10{}", x / 10f64.powi(e), superscript(e))
-}
-
-fn superscript(e: i32) -> String {
-    e.to_string()
-        .chars()
-        .map(|c| match c {
-            '-' => '⁻',
-            '0' => '⁰',
-            '1' => '¹',
-            '2' => '²',
-            '3' => '³',
-            '4' => '⁴',
-            '5' => '⁵',
-            '6' => '⁶',
-            '7' => '⁷',
-            '8' => '⁸',
-            _ => '⁹',
-        })
-        .collect()
 }
 
 #[cfg(test)]

@@ -32,6 +32,7 @@ mod parse;
 mod progress;
 pub mod scenes;
 pub mod schlieren;
+pub mod text;
 pub mod view;
 
 use clap::{Parser, Subcommand};
