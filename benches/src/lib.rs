@@ -1,8 +1,7 @@
 //! Shared pieces of the benchmarks, the report and the demo: deterministic
-//! test scenes, ray sets and PNG output.
+//! test scenes, ray sets and the report's plots.
 // A std-only tool crate: the no_std import lints guard the libraries.
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
-pub mod image;
 pub mod plot;
 pub mod scenes;

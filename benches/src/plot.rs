@@ -6,12 +6,12 @@
 //! licence is `assets/DejaVuSans-LICENSE`) and rasterised by `ab_glyph`, so
 //! no system font library is needed. The PNG is written with `png`.
 
-use std::{fmt, fs::File, io::BufWriter, ops::Range, path::Path};
+use std::{fmt, ops::Range, path::Path};
 
 use plotters::{backend::DrawingBackend, drawing::DrawingAreaErrorKind, prelude::*};
 use rt_cli::text::{FAMILY, register_font_once, superscript};
 
-use crate::image::WriteError;
+use rt_cli::image::{WriteError, write_rgb8};
 
 /// The smallest and largest width or height, in pixels: below the smallest
 /// the axis texts do not fit.
@@ -220,7 +220,7 @@ pub fn loglog(plot: &Plot, width: u32, height: u32, path: &Path) -> Result<(), P
             .draw()?;
         root.present()?;
     }
-    write_rgb_png(&rgb, width, height, path).map_err(PlotError::Write)
+    write_rgb8(&rgb, width, height, path).map_err(PlotError::Write)
 }
 
 /// Registers the embedded font with plotters once per process.
@@ -376,19 +376,6 @@ fn legend_corner<'a>(
     .into_iter()
     .min_by_key(|c| c.1)
     .map_or(SeriesLabelPosition::UpperRight, |c| c.0)
-}
-
-/// Writes 8-bit sRGB RGB pixels as a PNG.
-fn write_rgb_png(rgb: &[u8], width: u32, height: u32, path: &Path) -> Result<(), WriteError> {
-    let err = |source| WriteError { path: path.to_path_buf(), source };
-    let f = File::create(path).map_err(|e| err(e.into()))?;
-    let mut enc = png::Encoder::new(BufWriter::new(f), width, height);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-    let mut w = enc.write_header().map_err(err)?;
-    w.write_image_data(rgb).map_err(err)?;
-    w.finish().map_err(err)
 }
 
 #[cfg(test)]
