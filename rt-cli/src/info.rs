@@ -5,12 +5,9 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use rt_photo::{Cutoff, Mode};
 use rt_surface::io::{MeshData, read_mesh};
-use rt_volume::{GLADSTONE_DALE_AIR, Grid, io::read_grid};
+use rt_volume::{Grid, io::read_grid};
 
-use crate::{
-    optics::{Axis, Interpolation, Quantity, Volume},
-    parse,
-};
+use crate::optics::{Axis, Interpolation, Samples, Volume};
 
 /// `rt info FILE`: options.
 #[derive(Debug, clap::Args)]
@@ -18,12 +15,9 @@ pub struct Args {
     /// A volume (.nrrd, .nhdr, .json, .raw, .vtk, .vti) or a mesh (.obj,
     /// .ply, .vtk, .vtp).
     pub file: PathBuf,
-    /// For volumes: what the samples are (for the deflection survey).
-    #[arg(long, value_enum, default_value_t = Quantity::Density)]
-    pub quantity: Quantity,
-    /// Gladstone–Dale constant K in m³/kg.
-    #[arg(long, default_value_t = GLADSTONE_DALE_AIR, value_parser = parse::positive, allow_hyphen_values = true)]
-    pub k: f64,
+    /// What the samples are.
+    #[command(flatten)]
+    pub samples: Samples,
     /// For volumes: the beam direction of the deflection survey.
     #[arg(long, value_enum, default_value_t = Axis::Z)]
     pub axis: Axis,
@@ -92,7 +86,7 @@ fn volume(a: &Args, g: &Grid) -> anyhow::Result<String> {
         b.max.z,
         range(g.data().iter().map(|&v| f64::from(v))),
     );
-    let v = Volume::new(g.clone(), a.quantity, a.k, true, Interpolation::Linear)
+    let v = Volume::new(g.clone(), a.samples.quantity, a.samples.k, true, Interpolation::Linear)
         .context("preparing the deflection survey")?;
     text += &format!("index {}\n", range(v.field.grid().data().iter().map(|&n| f64::from(n))));
     let bench = v.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);

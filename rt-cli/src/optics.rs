@@ -22,6 +22,17 @@ pub enum Quantity {
     Index,
 }
 
+/// What a volume's samples are, as `rt schlieren` and `rt info` take it.
+#[derive(Clone, Copy, Debug, clap::Args)]
+pub struct Samples {
+    /// What the samples are.
+    #[arg(long, value_enum, default_value_t = Quantity::Density)]
+    pub quantity: Quantity,
+    /// Gladstone–Dale constant K in m³/kg (n = 1 + K·ρ; air at 589 nm).
+    #[arg(long, default_value_t = GLADSTONE_DALE_AIR, value_parser = crate::parse::positive, allow_hyphen_values = true)]
+    pub k: f64,
+}
+
 /// How the field is interpolated between samples. Both take the fast
 /// path: the octree bounds either interpolant (rt-volume's `skip`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

@@ -7,12 +7,12 @@ use anyhow::{Context, bail};
 use clap::ValueEnum;
 use rt_core::Frame;
 use rt_photo::{Bench, Cutoff, Film, FilterImage, Mode};
-use rt_volume::{GLADSTONE_DALE_AIR, glam::DVec3, io::read_grid};
+use rt_volume::{glam::DVec3, io::read_grid};
 
 use crate::{
     figure::{self, Figure, Legend},
     image,
-    optics::{Axis, Interpolation, Quantity, Survey, Volume},
+    optics::{Axis, Interpolation, Samples, Survey, Volume},
     parse,
 };
 
@@ -45,11 +45,8 @@ pub struct Args {
     /// VTK image data (.vtk/.vti).
     pub file: PathBuf,
     /// What the samples are.
-    #[arg(long, value_enum, default_value_t = Quantity::Density)]
-    pub quantity: Quantity,
-    /// Gladstone–Dale constant K in m³/kg (n = 1 + K·ρ; air at 589 nm).
-    #[arg(long, default_value_t = GLADSTONE_DALE_AIR, value_parser = parse::positive, allow_hyphen_values = true)]
-    pub k: f64,
+    #[command(flatten)]
+    pub samples: Samples,
     /// Accept densities ≤ 0 (or indices below 1) instead of refusing them.
     #[arg(long)]
     pub allow_nonphysical: bool,
@@ -181,7 +178,7 @@ fn optics(a: &Args, survey: &Survey, n_ref: f64) -> (Mode, f64, String) {
 /// unwritable output.
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let grid = read_grid(&a.file)?;
-    let volume = Volume::new(grid, a.quantity, a.k, a.allow_nonphysical, a.interp)
+    let volume = Volume::new(grid, a.samples.quantity, a.samples.k, a.allow_nonphysical, a.interp)
         .with_context(|| a.file.display().to_string())?;
     render(&volume, a)
 }
