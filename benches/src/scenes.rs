@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 use rt_core::{Camera, Projection, Ray, glam::Vec2, sampling};
-use rt_photo::{Bench, Cutoff, Mode, Weighting};
+use rt_photo::{Bench, Cutoff, Mode, Reconstruction, Weighting};
 use rt_volume::{Grid, GridField, Interp, TraceParams, glam::DVec3};
 
 /// An indexed triangle mesh.
@@ -144,6 +144,7 @@ pub fn knife_bench(params: TraceParams, strata: u32) -> Bench {
         film_distance: 0.0,
         mode: Mode::Schlieren(Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.0, h: 4e-3 }),
         weighting: Weighting::Weight,
+        reconstruction: Reconstruction::Photons,
         strata,
         params,
     }

@@ -7,7 +7,9 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::ValueEnum;
-use rt_photo::{Bench, Cutoff, Film, Filter, Mode, Octree, TraceParams, Weighting, build_octree};
+use rt_photo::{
+    Bench, Cutoff, Film, Filter, Mode, Octree, Reconstruction, TraceParams, Weighting, build_octree,
+};
 use rt_volume::{GLADSTONE_DALE_AIR, Grid, GridField, Interp, gladstone_dale, glam::DVec3};
 
 use crate::progress;
@@ -150,6 +152,7 @@ impl Volume {
             film_distance,
             mode,
             weighting: Weighting::Weight,
+            reconstruction: Reconstruction::Sheet,
             strata: 1,
             params: self.params(),
         }
@@ -184,10 +187,7 @@ impl Volume {
     ) -> anyhow::Result<(Film, f64)> {
         let height = ((width as f64) * bench.height / bench.width).round().max(1.0) as usize;
         let mut film = Film::new(width, height, Filter::Tent)?;
-        // 2×2 strata per pass from 4 photons per pixel: stratified, and
-        // enough passes for the bar to move.
-        let strata: u32 = if photons >= 4 { 2 } else { 1 };
-        let passes = u64::from(photons.div_ceil(strata * strata));
+        let (strata, passes) = lattice(photons);
         let bench = Bench { strata, ..bench.clone() };
         let per_pass = (width * height) as u64 * u64::from(strata * strata);
         let bar = progress::bar(per_pass * passes, "photons");
@@ -218,6 +218,24 @@ impl Volume {
             pixel: (bench.width / WIDTH as f64, bench.height / height),
         })
     }
+}
+
+/// The lattice that traces `photons` photons per pixel: `(k, passes)`, a
+/// `k × k` lattice per pixel in each pass. The sheet spreads each cell's
+/// light over the cell's image, which blurs a jump in the image (trilinear
+/// data's gradient jumps at cell faces) over `1/k` of a pixel; so `k`
+/// grows with the photons — the largest power of two with at least 4
+/// passes of `k²` (2 from 4 photons per pixel: 16 → 2, 64 → 4, 256 → 8)
+/// — and the passes, shifted along R2, fill in between. `photons` rounds
+/// up to whole passes.
+#[must_use]
+pub fn lattice(photons: u32) -> (u32, u64) {
+    let mut k = 1u32;
+    while 4 * (2 * k) * (2 * k) <= photons.max(16) && k < 64 {
+        k *= 2;
+    }
+    let k = if photons < 4 { 1 } else { k };
+    (k, u64::from(photons.div_ceil(k * k)))
 }
 
 /// Mean deflection per pixel of a coarse, uncut image of the volume.
@@ -290,5 +308,18 @@ mod tests {
         assert_eq!(quantile(vec![], 0.5), 0.0);
         assert_eq!(quantile(vec![3.0, f64::NAN, 1.0, 2.0], 0.5), 2.0);
         assert_eq!(quantile((1..=100).map(f64::from).collect(), 0.99), 99.0);
+    }
+
+    #[test]
+    fn the_lattice_refines_with_the_photons() {
+        assert_eq!(lattice(1), (1, 1));
+        assert_eq!(lattice(3), (1, 3));
+        assert_eq!(lattice(4), (2, 1));
+        assert_eq!(lattice(16), (2, 4));
+        assert_eq!(lattice(17), (2, 5));
+        assert_eq!(lattice(63), (2, 16));
+        assert_eq!(lattice(64), (4, 4));
+        assert_eq!(lattice(256), (8, 4));
+        assert_eq!(lattice(65536), (64, 16));
     }
 }

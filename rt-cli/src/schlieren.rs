@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use clap::ValueEnum;
 use rt_core::Frame;
-use rt_photo::{Bench, Cutoff, Film, FilterImage, Mode};
+use rt_photo::{Bench, Cutoff, Film, FilterImage, Mode, Reconstruction};
 use rt_volume::{glam::DVec3, io::read_grid};
 
 use crate::{
@@ -92,10 +92,20 @@ pub struct Args {
     /// Image width in pixels (height follows the volume's aspect).
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=i64::from(parse::MAX_EDGE)))]
     pub size: u32,
-    /// Photons per pixel (rounded up to a multiple of 4: 2×2 strata per
-    /// pass).
+    /// Photons per pixel. Each pass traces a k×k lattice of photons per
+    /// pixel (k = 2 up to 63 photons, 4 from 64, 8 from 256: at least four
+    /// passes), shifted from pass to pass; each lattice cell carries its
+    /// light onto the film where its corners land, by exact area, so an
+    /// undisturbed beam has no grain at all and more photons sharpen the
+    /// image rather than average noise. Rounded up to whole passes.
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub photons: u32,
+    /// How photons become the image: `sheet` (each pass's lattice of
+    /// photons carried onto the film by exact area: no grain) or `photons`
+    /// (each photon splatted alone with a tent filter: grainy, the classic
+    /// Monte Carlo estimate, for comparison).
+    #[arg(long, value_enum, default_value_t = Estimator::Sheet)]
+    pub estimator: Estimator,
     /// Interpolation between samples.
     #[arg(long, value_enum, default_value_t = Interpolation::Linear)]
     pub interp: Interpolation,
@@ -120,6 +130,15 @@ pub struct Args {
     /// for the colour filter.
     #[arg(long)]
     pub raw16: bool,
+}
+
+/// How photons become the image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Estimator {
+    /// The lattice of each pass as a sheet, by exact area.
+    Sheet,
+    /// Photons splatted one by one with a tent filter.
+    Photons,
 }
 
 /// The most photons one run may trace.
@@ -193,7 +212,10 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<(Bench, String)> {
     let probe = volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
     let height = ((f64::from(a.size)) * probe.height / probe.width).round().max(1.0);
-    let photons = u64::from(a.size) * height as u64 * u64::from(a.photons.next_multiple_of(4));
+    let photons = u64::from(a.size) * height as u64 * {
+        let (k, passes) = crate::optics::lattice(a.photons);
+        passes * u64::from(k * k)
+    };
     if photons > MAX_PHOTONS {
         bail!(
             "{photons} photons is more than one run traces ({MAX_PHOTONS}); lower --size or --photons"
@@ -224,6 +246,10 @@ pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<(Bench, String)> {
 /// Bad optics, too many photons, an unwritable output.
 pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
     let (bench, chosen) = prepare(volume, a)?;
+    let bench = match a.estimator {
+        Estimator::Sheet => bench,
+        Estimator::Photons => Bench { reconstruction: Reconstruction::Photons, ..bench },
+    };
     let (film, seconds) = volume.render(&bench, a.size as usize, a.photons, a.seed)?;
     let scale = if matches!(bench.mode, Mode::Schlieren(Cutoff::None)) { 0.5 } else { 1.0 };
     let frame = image::film_frame(&film, scale)?;
@@ -294,7 +320,10 @@ fn figure(volume: &Volume, a: &Args, bench: &Bench, frame: &Frame, chosen: &str)
     Figure {
         image: figure::Image::from_frame(frame),
         title: format!("{mode}: {file}, beam along {along}{}", axis_name(bench.direction)),
-        subtitle: format!("{chosen}; {} photons per pixel", a.photons.next_multiple_of(4)),
+        subtitle: format!("{chosen}; {} photons per pixel", {
+            let (k, passes) = crate::optics::lattice(a.photons);
+            passes * u64::from(k * k)
+        }),
         axes: Some(axes),
         legend,
     }

@@ -121,6 +121,7 @@ fn bad_options_are_usage_errors_naming_the_valid_ones() {
         (vec!["schlieren", f, "--photons", "1e30"], "photons"),
         (vec!["schlieren", f, "--photons", "0"], "photons"),
         (vec!["schlieren", f, "--cutoff", "laser"], "knife"),
+        (vec!["schlieren", f, "--estimator", "kde"], "sheet"),
         (vec!["schlieren", f, "--f", "-1"], "must be > 0"),
         (vec!["view", "x.ply", "--size", "0x0"], "1 to 16384"),
         (vec!["view", "x.ply", "--colormap", "jet"], "viridis"),
@@ -148,7 +149,7 @@ fn info_describes_the_blast_wave() {
 fn schlieren_renders_deterministically_with_its_exposure_printed() {
     let dir = scratch("schlieren");
     let vol = bump_volume(&dir, false);
-    let run = |out: &Path| {
+    let run = |out: &Path, estimator: &str| {
         let o = rt(&[
             "schlieren",
             vol.to_str().unwrap(),
@@ -156,18 +157,23 @@ fn schlieren_renders_deterministically_with_its_exposure_printed() {
             "48",
             "--photons",
             "4",
+            "--estimator",
+            estimator,
             "--out",
             out.to_str().unwrap(),
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
         stdout(&o)
     };
-    let (a, b) = (dir.join("a.png"), dir.join("b.png"));
-    let said = run(&a);
-    run(&b);
+    let (a, b, c) = (dir.join("a.png"), dir.join("b.png"), dir.join("c.png"));
+    let said = run(&a, "sheet");
+    run(&b, "sheet");
     assert!(said.contains("knife edge at 0 deg, f = 1 m, h = "), "{said}");
     assert!(said.contains("48×48"), "{said}");
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    // The classic estimator is there for comparison, and differs.
+    run(&c, "photons");
+    assert_ne!(std::fs::read(&a).unwrap(), std::fs::read(&c).unwrap());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -11,6 +11,7 @@ use rt_volume::{
     trace, trace_beam, trace_visiting,
 };
 
+use crate::cutoff::Prepared;
 use crate::{Cutoff, CutoffError, Film, Photon, math};
 
 /// What the film records.
@@ -40,6 +41,29 @@ pub enum Weighting {
     Roulette,
 }
 
+/// How the photons of a pass become an image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Reconstruction {
+    /// Each photon lands alone and is spread by the film's [`Filter`]
+    /// (`crate::Filter`). The photons of a pixel are stratified, each pass
+    /// continuing a low-discrepancy sequence, so noise falls faster than
+    /// `1/√N`; but a pixel still counts photons whose landing points jitter
+    /// across its edges, and that count is noisy.
+    #[default]
+    Photons,
+    /// The photons of a pass form a lattice over the beam, `strata` points
+    /// per pixel along each axis, the whole lattice shifted per pass along
+    /// the R2 sequence from an offset drawn from the seed. Each lattice
+    /// cell carries its light onto the part of the film its corners' landing
+    /// points enclose (two triangles), shared among the pixels it overlaps
+    /// by exact area: the sheet estimator of Abel, Hahn & Kaehler (2012).
+    /// An undisturbed beam gives exactly the background, and where light
+    /// bends the error is that of approximating the optical map by flat
+    /// triangles, `O(1/strata²)` for a smooth field, not noise. The film's
+    /// filter is not used; weighting must be [`Weighting::Weight`].
+    Sheet,
+}
+
 /// Why a render could not run.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BenchError {
@@ -67,6 +91,9 @@ pub enum BenchError {
     ReferenceIndex(f64),
     /// The interferometer's fringe spacing is not finite and positive.
     FringeSpacing(f64),
+    /// [`Reconstruction::Sheet`] with [`Weighting::Roulette`]: a sheet
+    /// carries each cell's mean transmission, never a random 0 or 1.
+    SheetRoulette,
     /// Tracing a photon failed (or building the beam mask of
     /// [`Bench::render_grid`]).
     Trace(TraceError),
@@ -94,6 +121,12 @@ impl fmt::Display for BenchError {
             }
             Self::FringeSpacing(s) => {
                 write!(f, "fringe spacing must be finite and positive (got {s})")
+            }
+            Self::SheetRoulette => {
+                write!(
+                    f,
+                    "sheet reconstruction weights photons (Russian roulette is for splatting)"
+                )
             }
             Self::Trace(e) => write!(f, "trace: {e}"),
         }
@@ -148,6 +181,8 @@ pub struct Bench {
     pub mode: Mode,
     /// Cutoff weighting.
     pub weighting: Weighting,
+    /// How a pass's photons become the image.
+    pub reconstruction: Reconstruction,
     /// Photons per pixel per pass: `k × k`, placed by a low-discrepancy
     /// sequence that each pass continues.
     pub strata: u32,
@@ -196,6 +231,9 @@ impl Bench {
         if !(1..=64).contains(&self.strata) {
             return Err(BenchError::Strata(self.strata));
         }
+        if self.reconstruction == Reconstruction::Sheet && self.weighting == Weighting::Roulette {
+            return Err(BenchError::SheetRoulette);
+        }
         match &self.mode {
             Mode::Schlieren(c) => c.validate().map_err(BenchError::Cutoff),
             Mode::Interferometry { lambda, n_ref, fringe_spacing } => {
@@ -209,6 +247,64 @@ impl Bench {
                     Ok(())
                 }
             }
+        }
+    }
+
+    /// Traces the photon emitted at film coordinates `(px, py)` (pixels,
+    /// continuous) of a `w × h` film, and lands it on the film plane.
+    #[allow(clippy::too_many_arguments)]
+    fn photon(
+        &self,
+        tracer: &(impl Fn(DVec3, DVec3) -> Result<(TraceResult, [f32; 3]), TraceError> + Sync),
+        cutoff: Option<&Prepared<'_>>,
+        (w, h): (usize, usize),
+        px: f64,
+        py: f64,
+        rng: &mut rt_core::sampling::Rng,
+    ) -> Result<Photon, BenchError> {
+        let v = self.v();
+        let a = (px / w as f64 - 0.5) * self.width;
+        let b = (0.5 - py / h as f64) * self.height;
+        let o = self.center + a * self.u + b * v;
+        let (r, colour) = tracer(o, self.direction).map_err(BenchError::Trace)?;
+        let e = r.direction;
+        let (eu, ev) = (e.dot(self.u), e.dot(v));
+        // The exit ray carried (forward or back) to the film plane.
+        let along = e.dot(self.direction).max(1e-12);
+        let film_plane = self.image_plane + self.film_distance;
+        let to_film = film_plane - (r.position - self.center).dot(self.direction);
+        let p = r.position + (to_film / along) * e;
+        let fa = (p - self.center).dot(self.u);
+        let fb = (p - self.center).dot(v);
+        let fx = (fa / self.width + 0.5) * w as f64;
+        let fy = (0.5 - fb / self.height) * h as f64;
+        let weight = match &self.mode {
+            Mode::Schlieren(_) => {
+                let t = cutoff.map_or([1.0; 3], |p| p.transmit(eu, ev));
+                match self.weighting {
+                    Weighting::Weight => t,
+                    Weighting::Roulette => {
+                        let g = (t[0] + t[1] + t[2]) / 3.0;
+                        if uniform(rng) < g { [1.0; 3] } else { [0.0; 3] }
+                    }
+                }
+            }
+            Mode::Interferometry { lambda, n_ref, fringe_spacing } => {
+                let straight = (r.position - o).dot(self.direction);
+                let phi = core::f64::consts::TAU / lambda * (r.optical_path - n_ref * straight);
+                let carrier = fringe_spacing.map_or(0.0, |s| core::f64::consts::TAU * fa / s);
+                [(0.5 * (1.0 + math::cos(phi + carrier))) as f32; 3]
+            }
+        };
+        let weight = [weight[0] * colour[0], weight[1] * colour[1], weight[2] * colour[2]];
+        Ok(Photon::new(fx, fy, weight, (eu, ev)))
+    }
+
+    /// The cutoff, prepared, for schlieren.
+    fn cutoff(&self) -> Option<Prepared<'_>> {
+        match &self.mode {
+            Mode::Schlieren(c) => Some(c.prepare()),
+            Mode::Interferometry { .. } => None,
         }
     }
 
@@ -233,55 +329,14 @@ impl Bench {
         // `1/√passes`. The offsets do not depend on the pass.
         let mut offsets = rng_for(seed ^ 0x6a09_e667_f3bc_c909, row as u64);
         let mut out = Vec::with_capacity(w * k * k);
-        let v = self.v();
-        let cutoff = match &self.mode {
-            Mode::Schlieren(c) => Some(c.prepare()),
-            Mode::Interferometry { .. } => None,
-        };
-        let film_plane = self.image_plane + self.film_distance;
+        let cutoff = self.cutoff();
         for i in 0..w {
             for s in 0..k * k {
                 let shift = (f64::from(uniform(&mut offsets)), f64::from(uniform(&mut offsets)));
                 let (rx, ry) = r2(pass, shift);
                 let (jx, jy) = (((s % k) as f64 + rx) / k as f64, ((s / k) as f64 + ry) / k as f64);
-                let px = i as f64 + jx;
-                let py = row as f64 + jy;
-                let a = (px / w as f64 - 0.5) * self.width;
-                let b = (0.5 - py / h as f64) * self.height;
-                let o = self.center + a * self.u + b * v;
-                let (r, colour) = tracer(o, self.direction).map_err(BenchError::Trace)?;
-                let e = r.direction;
-                let (eu, ev) = (e.dot(self.u), e.dot(v));
-                // The exit ray carried (forward or back) to the film plane.
-                let along = e.dot(self.direction).max(1e-12);
-                let to_film = film_plane - (r.position - self.center).dot(self.direction);
-                let p = r.position + (to_film / along) * e;
-                let fa = (p - self.center).dot(self.u);
-                let fb = (p - self.center).dot(v);
-                let fx = (fa / self.width + 0.5) * w as f64;
-                let fy = (0.5 - fb / self.height) * h as f64;
-                let weight = match &self.mode {
-                    Mode::Schlieren(_) => {
-                        let t = cutoff.as_ref().map_or([1.0; 3], |p| p.transmit(eu, ev));
-                        match self.weighting {
-                            Weighting::Weight => t,
-                            Weighting::Roulette => {
-                                let g = (t[0] + t[1] + t[2]) / 3.0;
-                                if uniform(&mut rng) < g { [1.0; 3] } else { [0.0; 3] }
-                            }
-                        }
-                    }
-                    Mode::Interferometry { lambda, n_ref, fringe_spacing } => {
-                        let straight = (r.position - o).dot(self.direction);
-                        let phi =
-                            core::f64::consts::TAU / lambda * (r.optical_path - n_ref * straight);
-                        let carrier =
-                            fringe_spacing.map_or(0.0, |s| core::f64::consts::TAU * fa / s);
-                        [(0.5 * (1.0 + math::cos(phi + carrier))) as f32; 3]
-                    }
-                };
-                let weight = [weight[0] * colour[0], weight[1] * colour[1], weight[2] * colour[2]];
-                out.push(Photon::new(fx, fy, weight, (eu, ev)));
+                let (px, py) = (i as f64 + jx, row as f64 + jy);
+                out.push(self.photon(tracer, cutoff.as_ref(), (w, h), px, py, &mut rng)?);
             }
         }
         Ok(out)
@@ -423,6 +478,9 @@ impl Bench {
         seed: u64,
     ) -> Result<(), BenchError> {
         self.validate()?;
+        if self.reconstruction == Reconstruction::Sheet {
+            return self.sheet(tracer, film, pass, seed);
+        }
         let rows: Vec<usize> = (0..film.height()).collect();
         #[cfg(feature = "parallel")]
         let traced: Vec<Result<Vec<Photon>, BenchError>> = {
@@ -436,6 +494,66 @@ impl Bench {
         film.emitted += traced.iter().map(|r| r.len() as u64).sum::<u64>();
         film.splat_all(traced.iter().flatten());
         film.per_pixel += f64::from(self.strata * self.strata);
+        Ok(())
+    }
+
+    /// One pass of [`Reconstruction::Sheet`]: the lattice traced row by row
+    /// (in parallel), then each cell's two triangles shared out over the
+    /// film. The lattice has `strata` points per pixel and one more on each
+    /// side, so its cells cover the beam whatever the pass's shift; a cell
+    /// straddling the beam's edge carries only the light of its part inside.
+    fn sheet(
+        &self,
+        tracer: &(impl Fn(DVec3, DVec3) -> Result<(TraceResult, [f32; 3]), TraceError> + Sync),
+        film: &mut Film,
+        pass: u64,
+        seed: u64,
+    ) -> Result<(), BenchError> {
+        let (w, h) = (film.width(), film.height());
+        let k = self.strata as usize;
+        let kf = k as f64;
+        let (nx, ny) = (w * k + 2, h * k + 2);
+        let mut base = rng_for(seed ^ 0x6a09_e667_f3bc_c909, u64::MAX);
+        let shift = (f64::from(uniform(&mut base)), f64::from(uniform(&mut base)));
+        let (sx, sy) = r2(pass, shift);
+        // Lattice point `(a, b)` at film coordinates `((a − 1 + sx)/k, …)`.
+        let at = |a: usize, s: f64| (a as f64 - 1.0 + s) / kf;
+        let cutoff = self.cutoff();
+        let trace_row = |b: usize| -> Result<Vec<Photon>, BenchError> {
+            // Weighting is `Weight` (validated): the generator is unused.
+            let mut rng = rng_for(seed, b as u64);
+            (0..nx)
+                .map(|a| {
+                    self.photon(tracer, cutoff.as_ref(), (w, h), at(a, sx), at(b, sy), &mut rng)
+                })
+                .collect()
+        };
+        #[cfg(feature = "parallel")]
+        let traced: Vec<Result<Vec<Photon>, BenchError>> = {
+            use rayon::prelude::*;
+            (0..ny).into_par_iter().map(trace_row).collect()
+        };
+        #[cfg(not(feature = "parallel"))]
+        let traced: Vec<Result<Vec<Photon>, BenchError>> = (0..ny).map(trace_row).collect();
+        let lattice: Vec<Vec<Photon>> = traced.into_iter().collect::<Result<_, _>>()?;
+        film.emitted += (nx * ny) as u64;
+        // Lost: photons emitted inside the beam that landed off the film
+        // (the lattice's outer ring starts outside it).
+        film.lost += lattice
+            .iter()
+            .enumerate()
+            .flat_map(|(b, row)| row.iter().enumerate().map(move |(a, p)| (a, b, p)))
+            .filter(|&(a, b, p)| {
+                let (x, y) = (at(a, sx), at(b, sy));
+                let emitted = x >= 0.0 && y >= 0.0 && x < w as f64 && y < h as f64;
+                emitted && !(p.x >= 0.0 && p.y >= 0.0 && p.x < w as f64 && p.y < h as f64)
+            })
+            .count() as u64;
+        // Light per unit emission area: a full cell (1/k² pixel²) carries
+        // one photon's worth, so the background is k² per pixel per pass.
+        let density = kf * kf;
+        film.deposit_sheet(&lattice, |a, b| (at(a, sx), at(b, sy)), density);
+        film.per_pixel += density;
         Ok(())
     }
 }

@@ -3,7 +3,7 @@
 use alloc::vec::Vec;
 use core::fmt;
 
-use crate::math;
+use crate::{math, sheet};
 
 /// The reconstruction filter.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -117,7 +117,8 @@ pub struct Film {
     eps: Vec<[f64; 3]>,
     /// Photons emitted so far.
     pub emitted: u64,
-    /// Photons that landed outside the film (counted, not splatted).
+    /// Photons that landed outside the film (counted, not splatted; for a
+    /// sheet, those of its lattice emitted inside the beam).
     pub lost: u64,
     /// Photons emitted per pixel of an undisturbed image (the background).
     pub per_pixel: f64,
@@ -183,7 +184,7 @@ impl Film {
         let width = self.width;
         let (rgb, eps_acc) = (&mut self.rgb, &mut self.eps);
         footprint(self.filter, self.width, self.height, x, y, |i, j, k| {
-            deposit(&mut rgb[i + width * j], &mut eps_acc[i + width * j], k, w, eps);
+            deposit(&mut rgb[i + width * j], &mut eps_acc[i + width * j], k, w.map(f64::from), eps);
         });
     }
 
@@ -227,7 +228,7 @@ impl Film {
                         footprint(filter, width, height, x, y, |i, j, k| {
                             if (lo..hi).contains(&j) {
                                 let p = i + width * (j - lo);
-                                deposit(&mut rgb[p], &mut eps_acc[p], k, w, e);
+                                deposit(&mut rgb[p], &mut eps_acc[p], k, w.map(f64::from), e);
                             }
                         });
                     }
@@ -238,6 +239,104 @@ impl Film {
         for p in photons {
             self.splat(p.x, p.y, p.weight, p.deflection);
         }
+    }
+
+    /// Shares out the cells of a traced lattice ([`crate::Reconstruction::Sheet`]):
+    /// `lattice` holds rows of landed photons, all rows equally long, the
+    /// photon `(a, b)` emitted at film coordinates `emission(a, b)`; cell
+    /// `(a, b)` has corners `(a, b)`, `(a+1, b)`, `(a+1, b+1)`, `(a, b+1)`
+    /// (numbered 0–3) and carries `density` photons per unit of its
+    /// emission area (pixels²) inside the beam (the film's rectangle).
+    /// Where a cell inside the beam lands as a convex quadrilateral its
+    /// light, with its corners' mean weight and deflection, is spread
+    /// uniformly over it; a cell folded or twisted by the optics is shared
+    /// out as its triangles `[0, 1, 2]` and `[0, 2, 3]`, each over its own
+    /// image; a cell straddling the beam's edge as the parts of its
+    /// triangles inside the beam, carried by each triangle's affine map.
+    /// With feature `parallel` the film is split into bands of rows filled
+    /// in parallel, each taking the cells in the serial order: the same
+    /// image, bit for bit.
+    pub(crate) fn deposit_sheet(
+        &mut self,
+        lattice: &[Vec<Photon>],
+        emission: impl Fn(usize, usize) -> (f64, f64) + Sync,
+        density: f64,
+    ) {
+        let (width, height) = (self.width, self.height);
+        let (wd, ht) = (width as f64, height as f64);
+        // The rows of the film each row of cells may reach.
+        let reach: Vec<(f64, f64)> = lattice
+            .windows(2)
+            .map(|r| {
+                r.iter()
+                    .flatten()
+                    .map(|p| p.y)
+                    .filter(|y| y.is_finite())
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y), hi.max(y)))
+            })
+            .collect();
+        const CORNER: [(usize, usize); 4] = [(0, 0), (1, 0), (1, 1), (0, 1)];
+        let band = |lo: usize, rgb: &mut [[f64; 3]], eps: &mut [[f64; 3]]| {
+            let hi = lo + rgb.len() / width;
+            for (b, rows) in lattice.windows(2).enumerate() {
+                let (y0, y1) = reach[b];
+                if !(y1 >= lo as f64 && y0 < hi as f64) {
+                    continue;
+                }
+                for a in 0..rows[0].len().saturating_sub(1) {
+                    let c = [&rows[0][a], &rows[0][a + 1], &rows[1][a + 1], &rows[1][a]];
+                    // Spreads `e` photons with the mean weight and
+                    // deflection of `corners` uniformly over `image`.
+                    let mut spread = |corners: &[usize], image: &[(f64, f64)], e: f64| {
+                        let m = 1.0 / corners.len() as f64;
+                        let (mut w, mut d) = ([0.0; 3], (0.0, 0.0));
+                        for &i in corners {
+                            let p = c[i];
+                            for (wc, pc) in w.iter_mut().zip(p.weight) {
+                                *wc += m * f64::from(pc);
+                            }
+                            d = (d.0 + m * p.deflection.0, d.1 + m * p.deflection.1);
+                        }
+                        sheet::cover(image, width, height, (lo, hi), |i, j, k| {
+                            let p = i + width * (j - lo);
+                            deposit(&mut rgb[p], &mut eps[p], k * e, w, d);
+                        });
+                    };
+                    let landed = [0, 1, 2, 3].map(|i| (c[i].x, c[i].y));
+                    let from = CORNER.map(|(da, db)| emission(a + da, b + db));
+                    let inside =
+                        from[0].0 >= 0.0 && from[0].1 >= 0.0 && from[2].0 <= wd && from[2].1 <= ht;
+                    if !inside {
+                        for tri in [[0, 1, 2], [0, 2, 3]] {
+                            let (f, t) = (tri.map(|i| from[i]), tri.map(|i| landed[i]));
+                            if let Some((image, area)) = sheet::clip_and_map(f, t, wd, ht) {
+                                spread(&tri, image.vertices(), density * area);
+                            }
+                        }
+                    } else if sheet::convex(landed) {
+                        // One convex quadrilateral: one polygon to share out.
+                        spread(&[0, 1, 2, 3], &landed, 1.0);
+                    } else {
+                        for tri in [[0, 1, 2], [0, 2, 3]] {
+                            spread(&tri, &tri.map(|i| landed[i]), 0.5);
+                        }
+                    }
+                }
+            }
+        };
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            let bands = rayon::current_num_threads().clamp(1, height);
+            let rows = height.div_ceil(bands);
+            self.rgb
+                .par_chunks_mut(rows * width)
+                .zip(self.eps.par_chunks_mut(rows * width))
+                .enumerate()
+                .for_each(|(b, (rgb, eps))| band(b * rows, rgb, eps));
+        }
+        #[cfg(not(feature = "parallel"))]
+        band(0, &mut self.rgb, &mut self.eps);
     }
 
     /// Total deposited weight (RGB).
@@ -279,9 +378,9 @@ impl Film {
 
 /// Adds a photon's share `k` of weight `w` and deflection `eps` to a pixel.
 #[inline]
-fn deposit(rgb: &mut [f64; 3], acc: &mut [f64; 3], k: f64, w: [f32; 3], eps: (f64, f64)) {
+fn deposit(rgb: &mut [f64; 3], acc: &mut [f64; 3], k: f64, w: [f64; 3], eps: (f64, f64)) {
     for (a, wc) in rgb.iter_mut().zip(w) {
-        *a += k * f64::from(wc);
+        *a += k * wc;
     }
     acc[0] += k * eps.0;
     acc[1] += k * eps.1;

@@ -5,7 +5,11 @@
 //! field (`rt-volume`); each photon's deflection `ε` meets a cutoff (knife
 //! edge, graded filter, pinhole / dark field, colour filter) or, for
 //! interferometry, its optical path sets a phase; it lands on a film at its
-//! exit point carried a distance `L` further (shadowgraph).
+//! exit point carried a distance `L` further (shadowgraph). The film
+//! gathers photons one by one ([`Reconstruction::Photons`], stratified,
+//! spread by a [`Filter`]) or as a sheet ([`Reconstruction::Sheet`]: the
+//! photons of a pass form a lattice whose cells carry their light onto
+//! the film by exact area — no grain).
 //!
 //! Images are normalised to the background (1 = undisturbed, uncut) and
 //! deterministic: the same seed gives the same image, bit for bit, at any
@@ -33,7 +37,7 @@
 //! ```
 //! use rt_photo::glam::DVec3;
 //! use rt_photo::rt_volume::GaussianBump;
-//! use rt_photo::{Bench, Cutoff, Film, Filter, Mode, TraceParams, Weighting};
+//! use rt_photo::{Bench, Cutoff, Film, Filter, Mode, Reconstruction, TraceParams, Weighting};
 //!
 //! // n = 1 + 1e-4·exp(−r²/2), σ = 1, cut off beyond r = 5.
 //! let field = GaussianBump::new(DVec3::ZERO, 1e-4, 1.0, 5.0);
@@ -48,6 +52,7 @@
 //!     // f/h = 1500: a deflection of 1/3000 rad changes the image by 0.5.
 //!     mode: Mode::Schlieren(Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.5, h: 1e-3 }),
 //!     weighting: Weighting::Weight,
+//!     reconstruction: Reconstruction::Photons,
 //!     strata: 4, // 4 × 4 photons per pixel
 //!     params: TraceParams::accurate(),
 //! };
@@ -71,8 +76,9 @@ mod bench;
 mod cutoff;
 mod film;
 mod math;
+mod sheet;
 
-pub use bench::{Bench, BenchError, Mode, Weighting};
+pub use bench::{Bench, BenchError, Mode, Reconstruction, Weighting};
 pub use cutoff::{Cutoff, CutoffError, CutoffParam, FilterImage};
 pub use film::{Film, FilmError, Filter, Photon};
 // The types in this crate's signatures, from the crates below it (and

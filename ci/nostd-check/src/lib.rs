@@ -167,7 +167,7 @@ pub fn bend(g: f64) -> f64 {
 pub fn schlieren(delta: f64, eps: f64) -> f64 {
     use rt_photo::glam::DVec3;
     use rt_photo::rt_volume::GaussianBump;
-    use rt_photo::{Bench, Cutoff, Film, Filter, Mode, TraceParams, Weighting};
+    use rt_photo::{Bench, Cutoff, Film, Filter, Mode, Reconstruction, TraceParams, Weighting};
     let edge = Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.0, h: 1e-3 };
     if edge.validate().is_err() {
         return f64::NAN;
@@ -182,6 +182,7 @@ pub fn schlieren(delta: f64, eps: f64) -> f64 {
         film_distance: 0.0,
         mode: Mode::Schlieren(edge.clone()),
         weighting: Weighting::Weight,
+        reconstruction: Reconstruction::Photons,
         strata: 1,
         params: TraceParams::accurate(),
     };

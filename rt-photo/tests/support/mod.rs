@@ -2,7 +2,7 @@
 #![allow(dead_code, reason = "each test binary uses only part of it")]
 
 use rt_photo::glam::DVec3;
-use rt_photo::{Bench, Cutoff, Mode, TraceParams, Weighting};
+use rt_photo::{Bench, Cutoff, Mode, Reconstruction, TraceParams, Weighting};
 
 /// A beam along +z over `[-3, 3]²`, emitted at z = −6, imaging the plane
 /// z = 0 (`L = 0`), `strata²` photons per pixel, weighted.
@@ -17,6 +17,7 @@ pub(crate) fn bench(mode: Mode, strata: u32) -> Bench {
         film_distance: 0.0,
         mode,
         weighting: Weighting::Weight,
+        reconstruction: Reconstruction::Photons,
         strata,
         params: TraceParams::accurate(),
     }
