@@ -44,8 +44,8 @@ pub enum Weighting {
 /// How the photons of a pass become an image.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Reconstruction {
-    /// Each photon lands alone and is spread by the film's [`Filter`]
-    /// (`crate::Filter`). The photons of a pixel are stratified, each pass
+    /// Each photon lands alone and is spread by the film's
+    /// [`Filter`](crate::Filter). The photons of a pixel are stratified, each pass
     /// continuing a low-discrepancy sequence, so noise falls faster than
     /// `1/√N`; but a pixel still counts photons whose landing points jitter
     /// across its edges, and that count is noisy.
