@@ -33,7 +33,12 @@ impl<P: Primitive> Bvh<P> {
     #[inline]
     #[must_use]
     pub fn as_ref(&self) -> BvhRef<'_, P> {
-        BvhRef { nodes: &self.nodes, items: &self.items, prim_count: self.prim_count }
+        BvhRef {
+            nodes: &self.nodes,
+            items: &self.items,
+            prim_count: self.prim_count,
+            isa: crate::Isa::detect(),
+        }
     }
 
     /// See [`BvhRef::closest_hit`].

@@ -58,6 +58,7 @@ mod bytes;
 #[cfg(feature = "alloc")]
 mod check;
 mod error;
+mod isa;
 #[cfg(feature = "alloc")]
 mod mesh;
 mod node;
@@ -79,6 +80,7 @@ pub use build::{BuildParams, BuildQuality, build_capsules, build_spheres, build_
 pub use bvh::Bvh;
 pub use bytes::{Header, MAGIC, VERSION, validate};
 pub use error::{BuildError, LoadError};
+pub use isa::{Isa, UnsupportedIsa};
 #[cfg(feature = "alloc")]
 pub use mesh::TriangleMesh;
 pub use node::{ChildRef, GROUPS, MAX_ITEMS, MAX_LEAF_ITEMS, Node, WIDTH};

@@ -15,22 +15,18 @@ use crate::simd::F32x4;
 pub struct RayCtx {
     pub(crate) ray: Ray,
     /// Origin per axis, splatted.
-    #[cfg_attr(all(target_arch = "x86_64", target_feature = "avx"), allow(dead_code))]
     pub(crate) org: [F32x4; 3],
     /// Reciprocal direction per axis (`±∞` for `±0`).
-    #[cfg_attr(not(all(target_arch = "x86_64", target_feature = "avx")), allow(dead_code))]
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code, reason = "the AVX kernels"))]
     pub(crate) inv1: glam::Vec3,
     /// Reciprocal direction per axis, splatted.
-    #[cfg_attr(all(target_arch = "x86_64", target_feature = "avx"), allow(dead_code))]
     pub(crate) inv: [F32x4; 3],
     /// Row of `Node::bounds` holding the near plane per axis (by sign bit).
     pub(crate) near: [usize; 3],
     /// Row holding the far plane per axis.
     pub(crate) far: [usize; 3],
     /// `1 ± 2γ(3)`: far distances are widened outward by rounding bounds.
-    #[cfg_attr(all(target_arch = "x86_64", target_feature = "avx"), allow(dead_code))]
     pub(crate) far_up: F32x4,
-    #[cfg_attr(all(target_arch = "x86_64", target_feature = "avx"), allow(dead_code))]
     pub(crate) far_down: F32x4,
     pub(crate) t_min: F32x4,
     /// Watertight shear constants for triangles.

@@ -51,14 +51,12 @@ mod imp {
         }
         /// `self` if `self > o`, else `o` (so NaN in either gives `o`).
         #[inline(always)]
-        #[cfg_attr(target_feature = "avx", allow(dead_code, reason = "AVX node tests"))]
         pub(crate) fn max(self, o: Self) -> Self {
             // SAFETY: SSE is in the x86-64 baseline.
             Self(unsafe { _mm_max_ps(self.0, o.0) })
         }
         /// `self` if `self < o`, else `o` (so NaN in either gives `o`).
         #[inline(always)]
-        #[cfg_attr(target_feature = "avx", allow(dead_code, reason = "AVX node tests"))]
         pub(crate) fn min(self, o: Self) -> Self {
             // SAFETY: SSE is in the x86-64 baseline.
             Self(unsafe { _mm_min_ps(self.0, o.0) })
@@ -153,10 +151,12 @@ mod imp {
 
 pub(crate) use imp::F32x4;
 
-/// Eight f32 lanes on AVX, compiled only when the build enables AVX
-/// (`-C target-cpu=native` or `-C target-feature=+avx`): node tests then take
-/// one pass for all eight children. Same NaN rule as [`F32x4`].
-#[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+/// Eight f32 lanes on AVX, for the AVX2 and AVX-512 kernels ([`crate::Isa`]):
+/// a node's eight child boxes in one pass. Every method carries
+/// `#[target_feature(enable = "avx")]`, so the compiler lets only code
+/// compiled with AVX call it safely; the kernels that do are entered only
+/// after the CPU was found to have it. Same NaN rule as [`F32x4`].
+#[cfg(target_arch = "x86_64")]
 mod avx {
     use core::arch::x86_64::*;
 
@@ -164,48 +164,54 @@ mod avx {
     #[repr(transparent)]
     pub(crate) struct F32x8(__m256);
 
-    // SAFETY (every block below): AVX is enabled for this whole build, the
-    // module is compiled only then.
     impl F32x8 {
-        #[inline(always)]
+        #[inline]
+        #[target_feature(enable = "avx")]
         pub(crate) fn splat(x: f32) -> Self {
-            Self(unsafe { _mm256_set1_ps(x) })
+            Self(_mm256_set1_ps(x))
         }
-        #[inline(always)]
+        #[inline]
+        #[target_feature(enable = "avx")]
         pub(crate) fn from_groups(g: [[f32; 4]; 2]) -> Self {
             Self(bytemuck::cast(g))
         }
-        #[inline(always)]
+        #[inline]
+        #[target_feature(enable = "avx")]
         pub(crate) fn to_array(self) -> [f32; 8] {
             bytemuck::cast(self.0)
         }
-        #[inline(always)]
+        #[inline]
+        #[target_feature(enable = "avx")]
         pub(crate) fn sub(self, o: Self) -> Self {
-            Self(unsafe { _mm256_sub_ps(self.0, o.0) })
+            Self(_mm256_sub_ps(self.0, o.0))
         }
-        #[inline(always)]
+        #[inline]
+        #[target_feature(enable = "avx")]
         pub(crate) fn mul(self, o: Self) -> Self {
-            Self(unsafe { _mm256_mul_ps(self.0, o.0) })
+            Self(_mm256_mul_ps(self.0, o.0))
         }
         /// `self` if `self > o`, else `o` (NaN in either gives `o`).
-        #[inline(always)]
+        #[inline]
+        #[target_feature(enable = "avx")]
         pub(crate) fn max(self, o: Self) -> Self {
-            Self(unsafe { _mm256_max_ps(self.0, o.0) })
+            Self(_mm256_max_ps(self.0, o.0))
         }
         /// `self` if `self < o`, else `o` (NaN in either gives `o`).
-        #[inline(always)]
+        #[inline]
+        #[target_feature(enable = "avx")]
         pub(crate) fn min(self, o: Self) -> Self {
-            Self(unsafe { _mm256_min_ps(self.0, o.0) })
+            Self(_mm256_min_ps(self.0, o.0))
         }
         /// Bit `i` set where lane `i` has `self <= o` (false for NaN).
-        #[inline(always)]
+        #[inline]
+        #[target_feature(enable = "avx")]
         pub(crate) fn le_mask(self, o: Self) -> u32 {
-            (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) }) as u32
+            _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) as u32
         }
     }
 }
 
-#[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+#[cfg(target_arch = "x86_64")]
 pub(crate) use avx::F32x8;
 
 /// Hints the CPU to start loading the first two cache lines of `r`.

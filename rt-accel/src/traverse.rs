@@ -4,7 +4,7 @@
 use rt_core::{Aabb, Hit, Ray, SceneQuery, internal::widen_far};
 
 use crate::{
-    RayCtx,
+    Isa, RayCtx, UnsupportedIsa,
     node::{ChildRef, GROUPS, Node, WIDTH},
     prim::{BestHit, Primitive},
     simd::prefetch,
@@ -19,11 +19,15 @@ pub const STACK_SIZE: usize = (WIDTH - 1) * MAX_DEPTH + 1;
 /// primitives their ids refer to. Built by [`crate::Bvh::as_ref`] or
 /// [`BvhRef::from_bytes`], which check every invariant the traversal relies
 /// on, so traversal never reads out of bounds and always terminates.
+/// Queries run on the widest kernel the CPU has ([`Isa::detect`]);
+/// [`BvhRef::with_isa`] picks another, with the same answers.
 #[derive(Debug)]
 pub struct BvhRef<'a, P: Primitive> {
     pub(crate) nodes: &'a [Node],
     pub(crate) items: &'a [P],
     pub(crate) prim_count: u32,
+    /// Always one [`Isa::is_available`] approved: the dispatch relies on it.
+    pub(crate) isa: Isa,
 }
 
 impl<P: Primitive> Clone for BvhRef<'_, P> {
@@ -67,6 +71,21 @@ pub struct TraversalStats {
 }
 
 impl<'a, P: Primitive> BvhRef<'a, P> {
+    /// The traversal kernel queries run on.
+    #[must_use]
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
+    /// The same BVH queried with kernel `isa` (to compare kernels, or to
+    /// pin one); every kernel returns the same hits, bit for bit.
+    ///
+    /// # Errors
+    /// [`UnsupportedIsa`] if this CPU or target cannot run it.
+    pub fn with_isa(self, isa: Isa) -> Result<Self, UnsupportedIsa> {
+        if isa.is_available() { Ok(Self { isa, ..self }) } else { Err(UnsupportedIsa(isa)) }
+    }
+
     /// The nodes (root first; empty for an empty BVH).
     #[must_use]
     pub fn nodes(&self) -> &'a [Node] {
@@ -144,10 +163,38 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         let Some(ctx) = RayCtx::new(ray) else {
             return false;
         };
+        match self.isa {
+            // SAFETY: `self.isa` passed `Isa::is_available` (the field's
+            // invariant): the CPU has the features these kernels enable.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => unsafe { self.occluded_avx512(&ctx, stack) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as above.
+            Isa::Avx2 => unsafe { self.occluded_avx2(&ctx, stack) },
+            _ => self.occluded_kernel::<false>(&ctx, stack),
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    fn occluded_avx2(&self, ctx: &RayCtx, stack: &mut TraversalStack) -> bool {
+        self.occluded_kernel::<true>(ctx, stack)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
+    fn occluded_avx512(&self, ctx: &RayCtx, stack: &mut TraversalStack) -> bool {
+        self.occluded_kernel::<true>(ctx, stack)
+    }
+
+    /// The occlusion kernel: any hit ends it. `AVX`: test a node's boxes
+    /// in one 8-wide pass (only inside the AVX kernels above).
+    #[inline(always)]
+    fn occluded_kernel<const AVX: bool>(&self, ctx: &RayCtx, stack: &mut TraversalStack) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        let t_max = ray.t_max;
+        let t_max = ctx.ray.t_max;
         let stack = &mut stack.refs;
         let mut sp = 0;
         let mut cur = ChildRef::inner(0);
@@ -155,17 +202,17 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             if cur.is_leaf() {
                 let (first, count) = cur.leaf_range();
                 for item in &self.items[first..first + count] {
-                    if item.any(&ctx, t_max) {
+                    if item.any(ctx, t_max) {
                         return true;
                     }
                 }
             } else {
                 let node = &self.nodes[cur.index()];
-                // Widened as in `closest_best`: a box entered at a rounded
+                // Widened as in `closest_kernel`: a box entered at a rounded
                 // distance just past `t_max` may hold a hit at exactly
                 // `t_max` (found by the `bvh` fuzz target with
                 // `t_min = t_max`).
-                let (mask, _) = box_test(node, &ctx, widen_far(t_max));
+                let (mask, _) = box_test::<AVX>(node, ctx, widen_far(t_max));
                 let mut m = mask;
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
@@ -196,10 +243,53 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         }
     }
 
-    /// The traversal kernel: front-to-back by entry distance, culling
-    /// stacked subtrees that start beyond the best hit.
+    /// The closest-hit traversal on this BVH's kernel.
     #[inline]
     fn closest_best(
+        &self,
+        ctx: &RayCtx,
+        stats: &mut TraversalStats,
+        stack: &mut TraversalStack,
+    ) -> BestHit {
+        match self.isa {
+            // SAFETY: `self.isa` passed `Isa::is_available` (the field's
+            // invariant): the CPU has the features these kernels enable.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => unsafe { self.closest_avx512(ctx, stats, stack) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as above.
+            Isa::Avx2 => unsafe { self.closest_avx2(ctx, stats, stack) },
+            _ => self.closest_kernel::<false>(ctx, stats, stack),
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    fn closest_avx2(
+        &self,
+        ctx: &RayCtx,
+        stats: &mut TraversalStats,
+        stack: &mut TraversalStack,
+    ) -> BestHit {
+        self.closest_kernel::<true>(ctx, stats, stack)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
+    fn closest_avx512(
+        &self,
+        ctx: &RayCtx,
+        stats: &mut TraversalStats,
+        stack: &mut TraversalStack,
+    ) -> BestHit {
+        self.closest_kernel::<true>(ctx, stats, stack)
+    }
+
+    /// The traversal kernel: front-to-back by entry distance, culling
+    /// stacked subtrees that start beyond the best hit. `AVX`: test a
+    /// node's boxes in one 8-wide pass (only inside the AVX kernels above).
+    #[inline(always)]
+    fn closest_kernel<const AVX: bool>(
         &self,
         ctx: &RayCtx,
         stats: &mut TraversalStats,
@@ -226,7 +316,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 // may still hold an exact tie; widen the bound as the far
                 // planes are widened.
                 let bound = widen_far(best.t);
-                let (mut mask, tnear) = box_test(node, ctx, bound);
+                let (mut mask, tnear) = box_test::<AVX>(node, ctx, bound);
                 // Gather the hit, non-empty children with their entry distances.
                 let mut refs = [ChildRef::EMPTY; WIDTH];
                 let mut ts = [0.0f32; WIDTH];
@@ -287,12 +377,24 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     }
 }
 
-/// Tests the ray against a node's boxes (Ize 2013's robust slab test, see
-/// [`rt_core::Aabb::intersect_ray`]), four per SSE pass. Returns the mask of
-/// boxes entered within `[t_min, t_max]` and the entry distances.
-#[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+/// The node test of kernel `AVX` (see [`box_test_avx`]) or the 4-wide one.
 #[inline(always)]
-fn box_test(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
+fn box_test<const AVX: bool>(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: `AVX` kernels are instantiated only inside the functions
+        // compiled with AVX enabled (`closest_avx2`, …), which are called
+        // only when `Isa::is_available` found the CPU has it.
+        return unsafe { box_test_avx(node, ctx, t_max) };
+    }
+    box_test_x4(node, ctx, t_max)
+}
+
+/// Tests the ray against a node's boxes (Ize 2013's robust slab test, see
+/// [`rt_core::Aabb::intersect_ray`]), four per 4-wide pass. Returns the
+/// mask of boxes entered within `[t_min, t_max]` and the entry distances.
+#[inline(always)]
+fn box_test_x4(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
     use crate::simd::F32x4;
     let b = &node.bounds;
     let t_max = F32x4::splat(t_max);
@@ -319,11 +421,12 @@ fn box_test(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
     (mask, tnear)
 }
 
-/// [`box_test`] in one AVX pass over all eight children (builds with AVX
-/// enabled). Identical arithmetic, lane for lane.
-#[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-#[inline(always)]
-fn box_test(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
+/// [`box_test_x4`] in one AVX pass over all eight children: identical
+/// arithmetic, lane for lane.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+#[target_feature(enable = "avx")]
+fn box_test_avx(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
     use crate::simd::F32x8;
     const { assert!(GROUPS == 2) };
     let b = &node.bounds;

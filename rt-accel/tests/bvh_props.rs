@@ -4,7 +4,7 @@ mod support;
 
 use proptest::prelude::*;
 use rt_accel::{
-    BuildParams, BuildQuality, Bvh, TriPacket, build_capsules, build_spheres, build_triangles,
+    BuildParams, BuildQuality, Bvh, Isa, TriPacket, build_capsules, build_spheres, build_triangles,
 };
 use rt_core::{
     Ray,
@@ -61,12 +61,16 @@ proptest! {
     #[test]
     fn triangles_match_brute_force((pos, idx) in soup(), rays in prop::collection::vec(ray(), 64), p in quality()) {
         let bvh = build_triangles(&pos, &idx, &p).unwrap();
-        for r in &rays {
-            let want = brute_triangles(&pos, &idx, r);
-            prop_assert_eq!(bvh_t(&bvh, r), want);
-            prop_assert_eq!(bvh.occluded(r), want.is_some());
-            if let Some(h) = bvh.closest_hit(r) {
-                prop_assert_eq!((h.t, h.prim), want.unwrap());
+        // On every kernel this CPU runs (Isa::detect's among them).
+        for isa in Isa::available() {
+            let view = bvh.as_ref().with_isa(isa).unwrap();
+            for r in &rays {
+                let want = brute_triangles(&pos, &idx, r);
+                prop_assert_eq!(view.closest_t(r).map(|b| (b.t, b.prim)), want, "{}", isa);
+                prop_assert_eq!(view.occluded(r), want.is_some(), "{}", isa);
+                if let Some(h) = view.closest_hit(r) {
+                    prop_assert_eq!((h.t, h.prim), want.unwrap());
+                }
             }
         }
     }
@@ -78,10 +82,13 @@ proptest! {
         p in quality(),
     ) {
         let bvh = build_spheres(&s, &p).unwrap();
-        for r in &rays {
-            let want = brute_spheres(&s, r);
-            prop_assert_eq!(bvh_t(&bvh, r), want);
-            prop_assert_eq!(bvh.occluded(r), want.is_some());
+        for isa in Isa::available() {
+            let view = bvh.as_ref().with_isa(isa).unwrap();
+            for r in &rays {
+                let want = brute_spheres(&s, r);
+                prop_assert_eq!(view.closest_t(r).map(|b| (b.t, b.prim)), want, "{}", isa);
+                prop_assert_eq!(view.occluded(r), want.is_some(), "{}", isa);
+            }
         }
     }
 
@@ -92,10 +99,13 @@ proptest! {
         p in quality(),
     ) {
         let bvh = build_capsules(&c, &p).unwrap();
-        for r in &rays {
-            let want = brute_capsules(&c, r);
-            prop_assert_eq!(bvh_t(&bvh, r), want);
-            prop_assert_eq!(bvh.occluded(r), want.is_some());
+        for isa in Isa::available() {
+            let view = bvh.as_ref().with_isa(isa).unwrap();
+            for r in &rays {
+                let want = brute_capsules(&c, r);
+                prop_assert_eq!(view.closest_t(r).map(|b| (b.t, b.prim)), want, "{}", isa);
+                prop_assert_eq!(view.occluded(r), want.is_some(), "{}", isa);
+            }
         }
     }
 
@@ -216,4 +226,23 @@ fn sphere_and_capsule_refit_match_brute_force() {
     bad[3].radius = f32::NAN;
     assert_eq!(sb.refit_spheres(&bad), Err(rt_accel::BuildError::InvalidPrimitive { index: 3 }));
     assert_eq!(sb, before);
+}
+
+/// Every kernel the CPU runs is offered, the widest by default; asking for
+/// one it cannot run is an error naming it, not a crash later.
+#[test]
+fn kernels_are_chosen_at_run_time_and_refused_when_missing() {
+    let (pos, idx) = icosphere(2);
+    let bvh = build_triangles(&pos, &idx, &params()).unwrap();
+    assert_eq!(bvh.as_ref().isa(), Isa::detect());
+    for isa in Isa::ALL {
+        match bvh.as_ref().with_isa(isa) {
+            Ok(view) => assert!(isa.is_available() && view.isa() == isa),
+            Err(e) => assert!(!isa.is_available() && e.0 == isa),
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    assert!(bvh.as_ref().with_isa(Isa::Portable).is_err());
+    let e = rt_accel::UnsupportedIsa(Isa::Avx512).to_string();
+    assert!(e.contains("avx512 traversal kernel"), "{e}");
 }

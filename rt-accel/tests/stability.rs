@@ -55,14 +55,11 @@ fn stored_triangles(bvh: &TriBvh) -> usize {
     bvh.items().iter().map(|p| p.len()).sum()
 }
 
-/// Asserts that every query of a triangle BVH answers `r` exactly as brute
-/// force does, and returns the brute-force answer.
+/// Asserts that every query of a triangle BVH, on every kernel the CPU
+/// runs, answers `r` exactly as brute force does, and returns the
+/// brute-force answer.
 fn check_triangles(bvh: &TriBvh, pos: &[Vec3], idx: &[[u32; 3]], r: &Ray) -> Option<(f32, u32)> {
-    let want = brute_triangles(pos, idx, r);
-    assert_eq!(bvh_t(bvh, r), want, "closest_t, {r:?}");
-    assert_eq!(bvh.closest_hit(r).map(|h| (h.t, h.prim)), want, "closest_hit, {r:?}");
-    assert_eq!(bvh.occluded(r), want.is_some(), "occluded, {r:?}");
-    want
+    check_items(bvh, r, |r| brute_triangles(pos, idx, r))
 }
 
 /// Like [`check_triangles`] for spheres or capsules, with `brute` the
@@ -74,8 +71,12 @@ fn check_items<P: Primitive>(
 ) -> Option<(f32, u32)> {
     let want = brute(r);
     assert_eq!(bvh_t(bvh, r), want, "closest_t, {r:?}");
-    assert_eq!(bvh.closest_hit(r).map(|h| (h.t, h.prim)), want, "closest_hit, {r:?}");
-    assert_eq!(bvh.occluded(r), want.is_some(), "occluded, {r:?}");
+    for isa in rt_accel::Isa::available() {
+        let v = bvh.as_ref().with_isa(isa).unwrap();
+        assert_eq!(v.closest_t(r).map(|b| (b.t, b.prim)), want, "closest_t, {isa}, {r:?}");
+        assert_eq!(v.closest_hit(r).map(|h| (h.t, h.prim)), want, "closest_hit, {isa}, {r:?}");
+        assert_eq!(v.occluded(r), want.is_some(), "occluded, {isa}, {r:?}");
+    }
     want
 }
 

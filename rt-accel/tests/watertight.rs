@@ -13,7 +13,19 @@ use support::*;
 /// directions that enter the mesh (toward its centre, jittered), and from
 /// inside points through the target.
 fn assert_closed(pos: &[Vec3], idx: &[[u32; 3]], center: Vec3) {
-    let bvh = build_triangles(pos, idx, &params()).unwrap();
+    let built = build_triangles(pos, idx, &params()).unwrap();
+    for isa in rt_accel::Isa::available() {
+        let bvh = built.as_ref().with_isa(isa).unwrap();
+        assert_closed_on(&bvh, pos, idx, center);
+    }
+}
+
+fn assert_closed_on(
+    bvh: &rt_accel::BvhRef<'_, rt_accel::TriPacket>,
+    pos: &[Vec3],
+    idx: &[[u32; 3]],
+    center: Vec3,
+) {
     let mut targets: Vec<Vec3> = pos.to_vec();
     for t in idx {
         for k in 0..3 {

@@ -1,6 +1,6 @@
 //! Embree 3 (feature `embree3`) as one more implementation in the
 //! traversal table: its own BVH (default build quality) and single-ray
-//! `rtcIntersect1`, same triangles, same rays.
+//! `rtcIntersect1` / `rtcOccluded1`, same triangles, same rays.
 
 use cgmath::{Vector3, Vector4};
 use embree::{
@@ -51,6 +51,22 @@ impl EmbreeScene {
         ));
         self.scene.intersect(ctx, &mut rh);
         rh.hit.hit().then_some((rh.ray.tfar, rh.hit.primID))
+    }
+}
+
+impl EmbreeScene {
+    /// Whether anything is hit (`rtcOccluded1`, which sets `tfar` to −∞
+    /// when it finds a hit).
+    pub(crate) fn occluded(&self, ctx: &mut IntersectContext, r: &rt_core::Ray) -> bool {
+        let (o, d) = (r.origin, r.direction);
+        let mut ray = Ray::segment(
+            Vector3::new(o.x, o.y, o.z),
+            Vector3::new(d.x, d.y, d.z),
+            r.t_min,
+            r.t_max,
+        );
+        self.scene.occluded(ctx, &mut ray);
+        ray.tfar == f32::NEG_INFINITY
     }
 }
 
