@@ -152,10 +152,11 @@ mod imp {
 pub(crate) use imp::F32x4;
 
 /// Eight f32 lanes on AVX, for the AVX2 and AVX-512 kernels ([`crate::Isa`]):
-/// a node's eight child boxes in one pass. Every method carries
-/// `#[target_feature(enable = "avx")]`, so the compiler lets only code
-/// compiled with AVX call it safely; the kernels that do are entered only
-/// after the CPU was found to have it. Same NaN rule as [`F32x4`].
+/// a node's eight child boxes in one pass. The methods are `unsafe`: they
+/// may run only where the CPU has AVX, i.e. inside the kernels compiled
+/// with it (`#[target_feature]`), which are entered only after run-time
+/// detection; they are always inlined there, so the intrinsics compile to
+/// AVX instructions in place. Same NaN rule as [`F32x4`].
 #[cfg(target_arch = "x86_64")]
 mod avx {
     use core::arch::x86_64::*;
@@ -164,49 +165,42 @@ mod avx {
     #[repr(transparent)]
     pub(crate) struct F32x8(__m256);
 
+    // SAFETY (every method): the caller guarantees the CPU has AVX.
     impl F32x8 {
-        #[inline]
-        #[target_feature(enable = "avx")]
-        pub(crate) fn splat(x: f32) -> Self {
-            Self(_mm256_set1_ps(x))
+        #[inline(always)]
+        pub(crate) unsafe fn splat(x: f32) -> Self {
+            Self(unsafe { _mm256_set1_ps(x) })
         }
-        #[inline]
-        #[target_feature(enable = "avx")]
+        #[inline(always)]
         pub(crate) fn from_groups(g: [[f32; 4]; 2]) -> Self {
             Self(bytemuck::cast(g))
         }
-        #[inline]
-        #[target_feature(enable = "avx")]
+        #[inline(always)]
         pub(crate) fn to_array(self) -> [f32; 8] {
             bytemuck::cast(self.0)
         }
-        #[inline]
-        #[target_feature(enable = "avx")]
-        pub(crate) fn sub(self, o: Self) -> Self {
-            Self(_mm256_sub_ps(self.0, o.0))
+        #[inline(always)]
+        pub(crate) unsafe fn sub(self, o: Self) -> Self {
+            Self(unsafe { _mm256_sub_ps(self.0, o.0) })
         }
-        #[inline]
-        #[target_feature(enable = "avx")]
-        pub(crate) fn mul(self, o: Self) -> Self {
-            Self(_mm256_mul_ps(self.0, o.0))
+        #[inline(always)]
+        pub(crate) unsafe fn mul(self, o: Self) -> Self {
+            Self(unsafe { _mm256_mul_ps(self.0, o.0) })
         }
         /// `self` if `self > o`, else `o` (NaN in either gives `o`).
-        #[inline]
-        #[target_feature(enable = "avx")]
-        pub(crate) fn max(self, o: Self) -> Self {
-            Self(_mm256_max_ps(self.0, o.0))
+        #[inline(always)]
+        pub(crate) unsafe fn max(self, o: Self) -> Self {
+            Self(unsafe { _mm256_max_ps(self.0, o.0) })
         }
         /// `self` if `self < o`, else `o` (NaN in either gives `o`).
-        #[inline]
-        #[target_feature(enable = "avx")]
-        pub(crate) fn min(self, o: Self) -> Self {
-            Self(_mm256_min_ps(self.0, o.0))
+        #[inline(always)]
+        pub(crate) unsafe fn min(self, o: Self) -> Self {
+            Self(unsafe { _mm256_min_ps(self.0, o.0) })
         }
         /// Bit `i` set where lane `i` has `self <= o` (false for NaN).
-        #[inline]
-        #[target_feature(enable = "avx")]
-        pub(crate) fn le_mask(self, o: Self) -> u32 {
-            _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) as u32
+        #[inline(always)]
+        pub(crate) unsafe fn le_mask(self, o: Self) -> u32 {
+            (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) }) as u32
         }
     }
 }

