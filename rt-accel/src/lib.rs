@@ -62,6 +62,7 @@ mod isa;
 #[cfg(feature = "alloc")]
 mod mesh;
 mod node;
+mod packet;
 mod prim;
 mod ray_ctx;
 #[cfg(feature = "alloc")]
@@ -84,6 +85,7 @@ pub use isa::{Isa, UnsupportedIsa};
 #[cfg(feature = "alloc")]
 pub use mesh::TriangleMesh;
 pub use node::{ChildRef, GROUPS, MAX_ITEMS, MAX_LEAF_ITEMS, Node, WIDTH};
+pub use packet::PACKET;
 pub use prim::{BestHit, CapsuleItem, Primitive, SphereItem};
 pub use ray_ctx::RayCtx;
 #[cfg(feature = "alloc")]

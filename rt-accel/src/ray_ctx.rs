@@ -17,7 +17,6 @@ pub struct RayCtx {
     /// Origin per axis, splatted.
     pub(crate) org: [F32x4; 3],
     /// Reciprocal direction per axis (`±∞` for `±0`).
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code, reason = "the AVX kernels"))]
     pub(crate) inv1: glam::Vec3,
     /// Reciprocal direction per axis, splatted.
     pub(crate) inv: [F32x4; 3],

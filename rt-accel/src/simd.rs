@@ -180,6 +180,15 @@ mod avx {
             bytemuck::cast(self.0)
         }
         #[inline(always)]
+        pub(crate) fn from_array(a: [f32; 8]) -> Self {
+            Self(bytemuck::cast(a))
+        }
+        /// `b` in the lanes where `mask`'s sign bit is set, else `self`.
+        #[inline(always)]
+        pub(crate) unsafe fn blend(self, b: Self, mask: Self) -> Self {
+            Self(unsafe { _mm256_blendv_ps(self.0, b.0, mask.0) })
+        }
+        #[inline(always)]
         pub(crate) unsafe fn sub(self, o: Self) -> Self {
             Self(unsafe { _mm256_sub_ps(self.0, o.0) })
         }

@@ -194,10 +194,21 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         if self.nodes.is_empty() {
             return false;
         }
+        self.occluded_from::<AVX>(ctx, ChildRef::inner(0), stack)
+    }
+
+    /// [`Self::occluded_kernel`] over the subtree `start` only.
+    #[inline(always)]
+    pub(crate) fn occluded_from<const AVX: bool>(
+        &self,
+        ctx: &RayCtx,
+        start: ChildRef,
+        stack: &mut TraversalStack,
+    ) -> bool {
         let t_max = ctx.ray.t_max;
         let stack = &mut stack.refs;
         let mut sp = 0;
-        let mut cur = ChildRef::inner(0);
+        let mut cur = start;
         loop {
             if cur.is_leaf() {
                 let (first, count) = cur.leaf_range();
@@ -295,13 +306,28 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         stats: &mut TraversalStats,
         stack: &mut TraversalStack,
     ) -> BestHit {
-        let mut best = BestHit::new(ctx.ray.t_max);
+        let best = BestHit::new(ctx.ray.t_max);
         if self.nodes.is_empty() {
             return best;
         }
+        self.closest_from::<AVX>(ctx, ChildRef::inner(0), best, stats, stack)
+    }
+
+    /// [`Self::closest_kernel`] over the subtree `start` only, improving
+    /// on `best` (the packets hand a subtree to it once a single ray is
+    /// left in it).
+    #[inline(always)]
+    pub(crate) fn closest_from<const AVX: bool>(
+        &self,
+        ctx: &RayCtx,
+        start: ChildRef,
+        mut best: BestHit,
+        stats: &mut TraversalStats,
+        stack: &mut TraversalStack,
+    ) -> BestHit {
         let TraversalStack { refs: stack_ref, ts: stack_t } = stack;
         let mut sp = 0;
-        let mut cur = ChildRef::inner(0);
+        let mut cur = start;
         'walk: loop {
             if cur.is_leaf() {
                 let (first, count) = cur.leaf_range();

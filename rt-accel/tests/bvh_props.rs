@@ -75,6 +75,46 @@ proptest! {
         }
     }
 
+    /// Packets of eight rays (some invalid, some sharing an origin) answer
+    /// exactly as the single-ray queries, on every kernel.
+    #[test]
+    fn packets_answer_as_single_rays(
+        (pos, idx) in soup(),
+        rays in prop::collection::vec(ray(), 8 * 6),
+        invalid in prop::collection::vec(0usize..8, 0..3),
+        p in quality(),
+    ) {
+        let bvh = build_triangles(&pos, &idx, &p).unwrap();
+        let mut rays = rays;
+        for (k, chunk) in rays.chunks_mut(8).enumerate() {
+            if k % 2 == 1 {
+                // A shared origin: camera-like.
+                let o = chunk[0].origin;
+                for r in chunk.iter_mut() {
+                    r.origin = o;
+                }
+            }
+            for &i in &invalid {
+                chunk[i].origin.x = f32::NAN;
+            }
+        }
+        for isa in Isa::available() {
+            let view = bvh.as_ref().with_isa(isa).unwrap();
+            for chunk in rays.chunks(8) {
+                let packet: &[Ray; 8] = chunk.try_into().unwrap();
+                let closest = view.closest_t_packet(packet);
+                let occluded = view.occluded_packet(packet);
+                for (i, r) in packet.iter().enumerate() {
+                    // `t` and primitive; `item`/`lane` may name another
+                    // reference to the same triangle (builds may split).
+                    let th = |b: Option<rt_accel::BestHit>| b.map(|b| (b.t.to_bits(), b.prim));
+                    prop_assert_eq!(th(closest[i]), th(view.closest_t(r)), "{} ray {}", isa, i);
+                    prop_assert_eq!(occluded[i], view.occluded(r), "{} ray {}", isa, i);
+                }
+            }
+        }
+    }
+
     #[test]
     fn spheres_match_brute_force(
         s in prop::collection::vec((vec3(10.0), 0.05f32..2.0).prop_map(|(c, r)| Sphere::new(c, r)), 1..100),
@@ -245,4 +285,39 @@ fn kernels_are_chosen_at_run_time_and_refused_when_missing() {
     assert!(bvh.as_ref().with_isa(Isa::Portable).is_err());
     let e = rt_accel::UnsupportedIsa(Isa::Avx512).to_string();
     assert!(e.contains("avx512 traversal kernel"), "{e}");
+}
+
+/// Camera rays of 8 × 1 tiles over a closed mesh: packets equal single
+/// rays on every kernel (hits at shared edges included), and an empty BVH
+/// or an all-invalid packet misses.
+#[test]
+fn camera_packets_answer_as_single_rays() {
+    let (pos, idx) = icosphere(4);
+    let bvh = build_triangles(&pos, &idx, &params()).unwrap();
+    let eye = Vec3::new(0.3, 0.4, 3.0);
+    let rays: Vec<Ray> = (0..64 * 64)
+        .map(|i| {
+            let (x, y) = ((i % 64) as f32 / 63.0 - 0.5, (i / 64) as f32 / 63.0 - 0.5);
+            Ray::new(eye, Vec3::new(x, y, -1.6))
+        })
+        .collect();
+    let mut hits = 0;
+    for isa in Isa::available() {
+        let view = bvh.as_ref().with_isa(isa).unwrap();
+        for chunk in rays.chunks(8) {
+            let packet: &[Ray; 8] = chunk.try_into().unwrap();
+            let (c, o) = (view.closest_t_packet(packet), view.occluded_packet(packet));
+            for (i, r) in packet.iter().enumerate() {
+                let th = |b: Option<rt_accel::BestHit>| b.map(|b| (b.t.to_bits(), b.prim));
+                assert_eq!(th(c[i]), th(view.closest_t(r)), "{isa}");
+                assert_eq!(o[i], view.occluded(r), "{isa}");
+                hits += usize::from(o[i]);
+            }
+        }
+    }
+    assert!(hits > 1000, "the sphere must fill part of the view: {hits}");
+    let nan = Ray::new(Vec3::NAN, Vec3::Z);
+    assert_eq!(bvh.as_ref().closest_t_packet(&[nan; 8]), [None; 8]);
+    let empty = build_triangles(&[], &[], &params()).unwrap();
+    assert_eq!(empty.as_ref().occluded_packet(&rays[..8].try_into().unwrap()), [false; 8]);
 }

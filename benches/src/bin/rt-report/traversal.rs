@@ -16,7 +16,9 @@ use obvhs::{
     ray::{Ray as ORay, RayHit},
     triangle::Triangle,
 };
-use rt_accel::{BuildParams, BuildQuality, Bvh, Isa, TraversalStack, TriPacket, build_triangles};
+use rt_accel::{
+    BuildParams, BuildQuality, Bvh, Isa, PACKET, TraversalStack, TriPacket, build_triangles,
+};
 use rt_benches::scenes::{self, Mesh};
 use rt_core::{Ray, camera::cosine_hemisphere, sampling, spawn_ray};
 
@@ -152,6 +154,37 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         let mut tracers: Vec<(String, Tracer<'_>)> = vec![("rt".into(), rt(Isa::detect()))];
         for isa in Isa::available() {
             tracers.push((format!("rt-{isa}"), rt(isa)));
+        }
+        // rt's packets: eight consecutive rays (8 × 1 pixels for the
+        // camera, shadow and AO rays) traced together.
+        {
+            let bvh = &bvh;
+            tracers.push((
+                "rt-packet8".into(),
+                Box::new(move |rays: &[Ray], q: Query| {
+                    let view = bvh.as_ref();
+                    let (mut n, mut sum) = (0u64, 0.0f64);
+                    let pad = Ray::new(glam::Vec3::NAN, glam::Vec3::Z);
+                    for chunk in rays.chunks(PACKET) {
+                        let mut packet = [pad; PACKET];
+                        packet[..chunk.len()].copy_from_slice(chunk);
+                        let packet = black_box(&packet);
+                        match q {
+                            Query::Closest => {
+                                for h in view.closest_t_packet(packet).into_iter().flatten() {
+                                    n += 1;
+                                    sum += f64::from(h.t);
+                                }
+                            }
+                            Query::Occluded => {
+                                n += view.occluded_packet(packet).iter().filter(|&&o| o).count()
+                                    as u64;
+                            }
+                        }
+                    }
+                    (n, sum)
+                }),
+            ));
         }
         // obvhs has no any-hit query: its occlusion rows run closest hit.
         tracers.push((
