@@ -190,6 +190,21 @@ pub struct Bench {
     pub params: TraceParams,
 }
 
+/// Rows `0..n` of photons traced by `row` (in parallel with feature
+/// `parallel`), in order; the first error if any row fails.
+fn rows(
+    n: usize,
+    row: impl Fn(usize) -> Result<Vec<Photon>, BenchError> + Sync,
+) -> Result<Vec<Vec<Photon>>, BenchError> {
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        (0..n).into_par_iter().map(&row).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    (0..n).map(row).collect()
+}
+
 /// The `n`-th point of the R2 sequence (Roberts 2018) in `[0, 1)²`,
 /// shifted by `shift` modulo 1.
 #[inline]
@@ -481,16 +496,7 @@ impl Bench {
         if self.reconstruction == Reconstruction::Sheet {
             return self.sheet(tracer, film, pass, seed);
         }
-        let rows: Vec<usize> = (0..film.height()).collect();
-        #[cfg(feature = "parallel")]
-        let traced: Vec<Result<Vec<Photon>, BenchError>> = {
-            use rayon::prelude::*;
-            rows.par_iter().map(|&r| self.row(tracer, film, r, pass, seed)).collect()
-        };
-        #[cfg(not(feature = "parallel"))]
-        let traced: Vec<Result<Vec<Photon>, BenchError>> =
-            rows.iter().map(|&r| self.row(tracer, film, r, pass, seed)).collect();
-        let traced: Vec<Vec<Photon>> = traced.into_iter().collect::<Result<_, _>>()?;
+        let traced = rows(film.height(), |r| self.row(tracer, film, r, pass, seed))?;
         film.emitted += traced.iter().map(|r| r.len() as u64).sum::<u64>();
         film.splat_all(traced.iter().flatten());
         film.per_pixel += f64::from(self.strata * self.strata);
@@ -528,14 +534,7 @@ impl Bench {
                 })
                 .collect()
         };
-        #[cfg(feature = "parallel")]
-        let traced: Vec<Result<Vec<Photon>, BenchError>> = {
-            use rayon::prelude::*;
-            (0..ny).into_par_iter().map(trace_row).collect()
-        };
-        #[cfg(not(feature = "parallel"))]
-        let traced: Vec<Result<Vec<Photon>, BenchError>> = (0..ny).map(trace_row).collect();
-        let lattice: Vec<Vec<Photon>> = traced.into_iter().collect::<Result<_, _>>()?;
+        let lattice = rows(ny, trace_row)?;
         film.emitted += (nx * ny) as u64;
         // Lost: photons emitted inside the beam that landed off the film
         // (the lattice's outer ring starts outside it).

@@ -203,7 +203,6 @@ impl Film {
     ) {
         #[cfg(feature = "parallel")]
         {
-            use rayon::prelude::*;
             let (width, height, filter) = (self.width, self.height, self.filter);
             let lost = photons.clone().filter(|p| !self.on_film(p.x, p.y)).count();
             // Rows a photon's footprint may reach beyond its own.
@@ -212,27 +211,21 @@ impl Film {
                 Filter::Tent => 1.0,
                 Filter::WideTent { radius } => radius.max(1.0) + 1.0,
             };
-            let bands = rayon::current_num_threads().clamp(1, height);
-            let rows = height.div_ceil(bands);
-            self.rgb
-                .par_chunks_mut(rows * width)
-                .zip(self.eps.par_chunks_mut(rows * width))
-                .enumerate()
-                .for_each(|(b, (rgb, eps_acc))| {
-                    let (lo, hi) = (b * rows, (b * rows + rgb.len() / width));
-                    for &Photon { x, y, weight: w, deflection: e } in photons.clone() {
-                        let on = x >= 0.0 && y >= 0.0 && x < width as f64 && y < height as f64;
-                        if !on || y + reach < lo as f64 || y - reach >= hi as f64 {
-                            continue;
-                        }
-                        footprint(filter, width, height, x, y, |i, j, k| {
-                            if (lo..hi).contains(&j) {
-                                let p = i + width * (j - lo);
-                                deposit(&mut rgb[p], &mut eps_acc[p], k, w.map(f64::from), e);
-                            }
-                        });
+            self.bands(|lo, rgb, eps_acc| {
+                let hi = lo + rgb.len() / width;
+                for &Photon { x, y, weight: w, deflection: e } in photons.clone() {
+                    let on = x >= 0.0 && y >= 0.0 && x < width as f64 && y < height as f64;
+                    if !on || y + reach < lo as f64 || y - reach >= hi as f64 {
+                        continue;
                     }
-                });
+                    footprint(filter, width, height, x, y, |i, j, k| {
+                        if (lo..hi).contains(&j) {
+                            let p = i + width * (j - lo);
+                            deposit(&mut rgb[p], &mut eps_acc[p], k, w.map(f64::from), e);
+                        }
+                    });
+                }
+            });
             self.lost += lost as u64;
         }
         #[cfg(not(feature = "parallel"))]
@@ -324,19 +317,27 @@ impl Film {
                 }
             }
         };
+        self.bands(band);
+    }
+
+    /// Calls `fill(first_row, rgb, eps)` on bands of whole rows covering
+    /// the film: one band per thread, in parallel, with feature `parallel`;
+    /// the whole film at once without. A pixel's sums then depend only on
+    /// the order `fill` visits its contributions, never on the banding.
+    fn bands(&mut self, fill: impl Fn(usize, &mut [[f64; 3]], &mut [[f64; 3]]) + Sync) {
         #[cfg(feature = "parallel")]
         {
             use rayon::prelude::*;
-            let bands = rayon::current_num_threads().clamp(1, height);
-            let rows = height.div_ceil(bands);
+            let (width, height) = (self.width, self.height);
+            let rows = height.div_ceil(rayon::current_num_threads().clamp(1, height));
             self.rgb
                 .par_chunks_mut(rows * width)
                 .zip(self.eps.par_chunks_mut(rows * width))
                 .enumerate()
-                .for_each(|(b, (rgb, eps))| band(b * rows, rgb, eps));
+                .for_each(|(b, (rgb, eps))| fill(b * rows, rgb, eps));
         }
         #[cfg(not(feature = "parallel"))]
-        band(0, &mut self.rgb, &mut self.eps);
+        fill(0, &mut self.rgb, &mut self.eps);
     }
 
     /// Total deposited weight (RGB).
