@@ -195,4 +195,8 @@ impl<P: Primitive> SceneQuery for Bvh<P> {
     fn occluded(&self, ray: &Ray) -> bool {
         self.as_ref().occluded(ray)
     }
+
+    fn closest_hit_packet(&self, rays: &[Ray; crate::PACKET]) -> [Option<Hit>; crate::PACKET] {
+        self.as_ref().closest_hit_packet(rays)
+    }
 }

@@ -22,17 +22,30 @@ impl Default for Scene {
     }
 }
 
-impl SceneQuery for Scene {
-    fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
-        // Each later kind searches only up to the best hit so far; on equal
-        // `t` the earlier kind wins.
+impl Scene {
+    /// The closest hit of `ray` given its closest triangle hit: each later
+    /// kind searches only up to the best hit so far; on equal `t` the
+    /// earlier kind wins.
+    fn after_triangles(&self, ray: &Ray, best: Option<Hit>) -> Option<Hit> {
         let closer = |best: Option<Hit>, next: &dyn Fn(&Ray) -> Option<Hit>| {
             let r = Ray { t_max: best.map_or(ray.t_max, |h| h.t), ..*ray };
             next(&r).filter(|h| best.is_none_or(|b| h.t < b.t)).or(best)
         };
-        let best = self.triangles.closest_hit(ray);
         let best = closer(best, &|r| self.spheres.closest_hit(r));
         closer(best, &|r| self.capsules.closest_hit(r))
+    }
+}
+
+impl SceneQuery for Scene {
+    fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        self.after_triangles(ray, self.triangles.closest_hit(ray))
+    }
+
+    /// The triangles as one packet (the kind that holds most of a scene);
+    /// spheres and capsules ray by ray, as [`Scene::closest_hit`].
+    fn closest_hit_packet(&self, rays: &[Ray; crate::PACKET]) -> [Option<Hit>; crate::PACKET] {
+        let tri = self.triangles.closest_hit_packet(rays);
+        core::array::from_fn(|i| self.after_triangles(&rays[i], tri[i]))
     }
 
     fn occluded(&self, ray: &Ray) -> bool {

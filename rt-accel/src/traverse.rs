@@ -124,7 +124,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     }
 
     /// The full hit record of a traversal's best hit.
-    fn record(&self, best: BestHit, ray: &Ray) -> Option<Hit> {
+    pub(crate) fn record(&self, best: BestHit, ray: &Ray) -> Option<Hit> {
         self.items[best.item as usize].hit(best.lane, ray, best.t)
     }
 
@@ -494,5 +494,11 @@ impl<P: Primitive> SceneQuery for BvhRef<'_, P> {
 
     fn occluded(&self, ray: &Ray) -> bool {
         BvhRef::occluded(self, ray)
+    }
+
+    fn closest_hit_packet(&self, rays: &[Ray; crate::PACKET]) -> [Option<Hit>; crate::PACKET] {
+        let best = self.closest_t_packet(rays);
+        // The same primitive's record whichever stored copy was found.
+        core::array::from_fn(|i| best[i].and_then(|b| self.record(b, &rays[i])))
     }
 }

@@ -49,4 +49,10 @@ pub trait SceneQuery {
     /// Whether anything is hit with `t` in `[ray.t_min, ray.t_max]`; may stop
     /// at the first hit found.
     fn occluded(&self, ray: &Ray) -> bool;
+    /// [`SceneQuery::closest_hit`] of eight rays at once, `out[i]` equal to
+    /// `closest_hit(&rays[i])`. Scenes that trace coherent rays together
+    /// (rt-accel's packets) override it; the default asks ray by ray.
+    fn closest_hit_packet(&self, rays: &[Ray; 8]) -> [Option<Hit>; 8] {
+        core::array::from_fn(|i| self.closest_hit(&rays[i]))
+    }
 }

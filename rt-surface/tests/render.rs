@@ -1,10 +1,13 @@
 //! The surface renderer against answers computed independently.
 
 use rt_accel::BuildParams;
-use rt_core::{Camera, ColorMap, ColorStop, Frame, Projection, glam::Vec3, intersect::Sphere};
+use rt_core::{
+    Aabb, Camera, ColorMap, ColorStop, Frame, Hit, Projection, Ray, SceneQuery, glam::Vec3,
+    intersect::Sphere,
+};
 use rt_surface::{
     Glyphs, Light, Material, MaterialError, Mesh, MeshError, ObjectKind, Paint, Renderer,
-    SceneError, Settings, SurfaceScene, Tube,
+    SceneError, Settings, ShadeScene, Surface, SurfaceScene, Tube,
 };
 
 fn quad(corners: [Vec3; 4]) -> Mesh {
@@ -378,6 +381,32 @@ fn frames_are_identical_at_any_thread_count() {
         assert_eq!(seen, (1..=tiles).map(|d| (d, tiles)).collect::<Vec<_>>());
     }
     assert!(same(&one, &r.frame().unwrap()));
+
+    // Camera rays go through the scene as packets of eight; asked one by
+    // one (the trait's default), every pixel and count is the same.
+    struct OneByOne<'a>(&'a SurfaceScene<'a>);
+    impl SceneQuery for OneByOne<'_> {
+        fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+            self.0.closest_hit(ray)
+        }
+        fn occluded(&self, ray: &Ray) -> bool {
+            self.0.occluded(ray)
+        }
+    }
+    impl ShadeScene for OneByOne<'_> {
+        fn surface(&self, hit: &Hit) -> Surface {
+            self.0.surface(hit)
+        }
+        fn bounds(&self) -> Aabb {
+            self.0.bounds()
+        }
+    }
+    let mut single = Renderer::new(view(), st.clone()).unwrap();
+    for _ in 0..3 {
+        single.render_pass(&OneByOne(&s));
+    }
+    assert_eq!(single.counts(), c1);
+    assert!(same(&one, &single.frame().unwrap()));
 }
 
 #[test]

@@ -45,14 +45,37 @@ impl<S: ShadeScene> Ctx<'_, S> {
         let mut pixels = Vec::with_capacity((tw * th) as usize);
         let stream_seed = self.settings.seed ^ u64::from(pass).wrapping_mul(0x9e37_79b9_7f4a_7c15);
         let mut pw = PixelWork { rng: rng_for(stream_seed, 0), counts: RayCounts::default() };
+        // Camera rays eight pixels of a row at a time, traced as a packet
+        // (`SceneQuery::closest_hit_packet`: the same hits as one by one);
+        // each pixel keeps its own random stream for the rest of its path.
+        let none = Ray::new(Vec3::NAN, Vec3::Z);
         for y in y0..y0 + th {
-            for x in x0..x0 + tw {
-                pw.rng = rng_for(stream_seed, u64::from(y) * u64::from(w) + u64::from(x));
-                let jitter = if pass == 0 { Vec2::splat(0.5) } else { uniform2(&mut pw.rng) };
-                let ray = self.camera.generate_ray(x, y, jitter, uniform2(&mut pw.rng));
-                pw.counts.primary += 1;
-                let (rgb, a, depth) = self.path(ray, 0, &mut pw);
-                pixels.push(([rgb.x, rgb.y, rgb.z, a], depth));
+            let mut x = x0;
+            while x < x0 + tw {
+                let n = (x0 + tw - x).min(8) as usize;
+                let mut rays = [none; 8];
+                let mut streams: [Rng; 8] = core::array::from_fn(|_| pw.rng.clone());
+                for (k, (ray, rng)) in rays.iter_mut().zip(&mut streams).take(n).enumerate() {
+                    let px = x + k as u32;
+                    *rng = rng_for(stream_seed, u64::from(y) * u64::from(w) + u64::from(px));
+                    let jitter = if pass == 0 { Vec2::splat(0.5) } else { uniform2(rng) };
+                    *ray = self.camera.generate_ray(px, y, jitter, uniform2(rng));
+                }
+                // Rays that miss the scene's box are not traced (`closest`).
+                let culled: [bool; 8] = core::array::from_fn(|k| {
+                    k < n && self.bounds.intersect_ray(&rays[k]).is_none()
+                });
+                let traced: [Ray; 8] =
+                    core::array::from_fn(|k| if culled[k] { none } else { rays[k] });
+                let first = self.scene.closest_hit_packet(&traced);
+                for k in 0..n {
+                    pw.rng = streams[k].clone();
+                    pw.counts.primary += 1;
+                    pw.counts.culled += u64::from(culled[k]);
+                    let (rgb, a, depth) = self.path_from(rays[k], first[k], 0, &mut pw);
+                    pixels.push(([rgb.x, rgb.y, rgb.z, a], depth));
+                }
+                x += n as u32;
             }
         }
         TileResult { x0, y0, w: tw, pixels, counts: pw.counts }
@@ -77,12 +100,25 @@ impl<S: ShadeScene> Ctx<'_, S> {
 
     /// Premultiplied colour, alpha and depth seen along `ray`: translucent
     /// layers composited front to back.
-    fn path(&self, mut ray: Ray, bounce: u32, pw: &mut PixelWork) -> (Vec3, f32, f32) {
+    fn path(&self, ray: Ray, bounce: u32, pw: &mut PixelWork) -> (Vec3, f32, f32) {
+        let first = self.closest(&ray, pw);
+        self.path_from(ray, first, bounce, pw)
+    }
+
+    /// [`Self::path`] with the closest hit of `ray` already found.
+    fn path_from(
+        &self,
+        mut ray: Ray,
+        first: Option<Hit>,
+        bounce: u32,
+        pw: &mut PixelWork,
+    ) -> (Vec3, f32, f32) {
         let (mut rgb, mut alpha, mut depth) = (Vec3::ZERO, 0.0f32, f32::INFINITY);
         // Distance along the first ray to the current ray's origin.
         let mut travelled = 0.0;
         let mut layers = 0;
-        while let Some(hit) = self.closest(&ray, pw) {
+        let mut found = first;
+        while let Some(hit) = found {
             let s = self.scene.surface(&hit);
             let opacity = s.material.opacity;
             if opacity > 0.0 {
@@ -102,6 +138,7 @@ impl<S: ShadeScene> Ctx<'_, S> {
             let next = spawn_ray(hit.position, hit.position_error, hit.normal, ray.direction);
             travelled += (next.origin - ray.origin).length();
             ray = next;
+            found = self.closest(&ray, pw);
         }
         (rgb, alpha, depth)
     }

@@ -259,6 +259,10 @@ impl SceneQuery for SurfaceScene<'_> {
         self.scene.closest_hit(ray)
     }
 
+    fn closest_hit_packet(&self, rays: &[Ray; 8]) -> [Option<Hit>; 8] {
+        self.scene.closest_hit_packet(rays)
+    }
+
     fn occluded(&self, ray: &Ray) -> bool {
         self.scene.occluded(ray)
     }
