@@ -43,10 +43,8 @@ struct Lanes {
     ctx: [Option<RayCtx>; PACKET],
     org: [[f32; PACKET]; 3],
     inv: [[f32; PACKET]; 3],
-    /// Whether the direction's sign bit is set, per axis and ray.
-    neg: [[bool; PACKET]; 3],
-    /// The same as a lane mask: −0.0 (sign bit set) where negative.
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code, reason = "the AVX kernels"))]
+    /// The direction's sign per axis and ray as a lane mask: −0.0 (sign
+    /// bit set) where the direction's sign bit is set, else 0.0.
     neg_mask: [[f32; PACKET]; 3],
     t_min: [f32; PACKET],
     /// Rays that are valid ([`Ray::is_valid`]), one bit each.
@@ -61,7 +59,6 @@ impl Lanes {
             ctx,
             org: [[0.0; PACKET]; 3],
             inv: [[0.0; PACKET]; 3],
-            neg: [[false; PACKET]; 3],
             neg_mask: [[0.0; PACKET]; 3],
             t_min: [0.0; PACKET],
             valid: 0,
@@ -72,8 +69,8 @@ impl Lanes {
                 for a in 0..3 {
                     l.org[a][r] = c.ray.origin[a];
                     l.inv[a][r] = c.inv1[a];
-                    l.neg[a][r] = c.ray.direction[a].is_sign_negative();
-                    l.neg_mask[a][r] = if l.neg[a][r] { -0.0 } else { 0.0 };
+                    let neg = c.ray.direction[a].is_sign_negative();
+                    l.neg_mask[a][r] = if neg { -0.0 } else { 0.0 };
                 }
                 l.t_min[r] = c.ray.t_min;
             }
@@ -106,7 +103,8 @@ fn child_test(node: &Node, c: usize, l: &Lanes, t_max: &[f32; PACKET]) -> (u32, 
     for r in 0..PACKET {
         let slab = |a: usize| {
             let (lo, hi) = (b[2 * a][g][k], b[2 * a + 1][g][k]);
-            let (near, far) = if l.neg[a][r] { (hi, lo) } else { (lo, hi) };
+            let neg = l.neg_mask[a][r].is_sign_negative();
+            let (near, far) = if neg { (hi, lo) } else { (lo, hi) };
             ((near - l.org[a][r]) * l.inv[a][r], (far - l.org[a][r]) * l.inv[a][r])
         };
         let (nx, fx) = slab(0);

@@ -238,6 +238,13 @@ pub fn lattice(photons: u32) -> (u32, u64) {
     (k, u64::from(photons.div_ceil(k * k)))
 }
 
+/// The photons per pixel [`lattice`] traces for `photons`: whole passes.
+#[must_use]
+pub fn traced_per_pixel(photons: u32) -> u64 {
+    let (k, passes) = lattice(photons);
+    passes * u64::from(k * k)
+}
+
 /// Mean deflection per pixel of a coarse, uncut image of the volume.
 #[derive(Clone, Debug)]
 pub struct Survey {

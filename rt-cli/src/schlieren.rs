@@ -212,10 +212,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<(Bench, String)> {
     let probe = volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
     let height = ((f64::from(a.size)) * probe.height / probe.width).round().max(1.0);
-    let photons = u64::from(a.size) * height as u64 * {
-        let (k, passes) = crate::optics::lattice(a.photons);
-        passes * u64::from(k * k)
-    };
+    let photons = u64::from(a.size) * height as u64 * crate::optics::traced_per_pixel(a.photons);
     if photons > MAX_PHOTONS {
         bail!(
             "{photons} photons is more than one run traces ({MAX_PHOTONS}); lower --size or --photons"
@@ -320,10 +317,10 @@ fn figure(volume: &Volume, a: &Args, bench: &Bench, frame: &Frame, chosen: &str)
     Figure {
         image: figure::Image::from_frame(frame),
         title: format!("{mode}: {file}, beam along {along}{}", axis_name(bench.direction)),
-        subtitle: format!("{chosen}; {} photons per pixel", {
-            let (k, passes) = crate::optics::lattice(a.photons);
-            passes * u64::from(k * k)
-        }),
+        subtitle: format!(
+            "{chosen}; {} photons per pixel",
+            crate::optics::traced_per_pixel(a.photons)
+        ),
         axes: Some(axes),
         legend,
     }

@@ -17,7 +17,7 @@ use obvhs::{
     triangle::Triangle,
 };
 use rt_accel::{
-    BuildParams, BuildQuality, Bvh, Isa, PACKET, TraversalStack, TriPacket, build_triangles,
+    BuildParams, BuildQuality, Bvh, BvhRef, Isa, PACKET, TraversalStack, TriPacket, build_triangles,
 };
 use rt_benches::scenes::{self, Mesh};
 use rt_core::{Ray, camera::cosine_hemisphere, sampling, spawn_ray};
@@ -47,6 +47,18 @@ enum Query {
 
 /// One implementation under test: traces all rays, returns (hits, Σt).
 type Tracer<'a> = Box<dyn Fn(&[Ray], Query) -> (u64, f64) + 'a>;
+
+/// rt's single-ray queries of kind `q` over `rays` on `view`, one reused
+/// stack: (hits, Σt).
+fn rt_count(view: &BvhRef<'_, TriPacket>, rays: &[Ray], q: Query) -> (u64, f64) {
+    let mut stack = TraversalStack::new();
+    match q {
+        Query::Closest => {
+            count(rays, |r| view.closest_t_with(r, &mut stack).map(|h| (h.t, h.prim)))
+        }
+        Query::Occluded => count(rays, |r| view.occluded_with(r, &mut stack).then_some((0.0, 0))),
+    }
+}
 
 /// Shadow and ambient-occlusion rays from the surface points the primary
 /// rays hit: toward a directional light, and one cosine-distributed ray
@@ -139,16 +151,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         let rt = |isa: Isa| -> Tracer<'_> {
             let bvh = &bvh;
             Box::new(move |rays: &[Ray], q: Query| {
-                let view = bvh.as_ref().with_isa(isa).expect("an available kernel");
-                let mut stack = TraversalStack::new();
-                match q {
-                    Query::Closest => {
-                        count(rays, |r| view.closest_t_with(r, &mut stack).map(|h| (h.t, h.prim)))
-                    }
-                    Query::Occluded => {
-                        count(rays, |r| view.occluded_with(r, &mut stack).then_some((0.0, 0)))
-                    }
-                }
+                rt_count(&bvh.as_ref().with_isa(isa).expect("an available kernel"), rays, q)
             })
         };
         let mut tracers: Vec<(String, Tracer<'_>)> = vec![("rt".into(), rt(Isa::detect()))];
@@ -237,18 +240,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
                 Box::new(move |rays: &[Ray], q: Query| {
                     use rayon::prelude::*;
                     rays.par_chunks(1024)
-                        .map(|c| {
-                            let view = bvh.as_ref();
-                            let mut stack = TraversalStack::new();
-                            match q {
-                                Query::Closest => count(c, |r| {
-                                    view.closest_t_with(r, &mut stack).map(|h| (h.t, h.prim))
-                                }),
-                                Query::Occluded => count(c, |r| {
-                                    view.occluded_with(r, &mut stack).then_some((0.0, 0))
-                                }),
-                            }
-                        })
+                        .map(|c| rt_count(&bvh.as_ref(), c, q))
                         .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1))
                 }),
             ));
