@@ -5,6 +5,8 @@
 //! and every invariant traversal relies on (see [`validate`]), so a
 //! malformed blob is an `Err`, never a panic or an out-of-bounds read.
 
+use rt_core::Aabb;
+
 use crate::{LoadError, MAX_DEPTH, node::Node, prim::Primitive, traverse::BvhRef};
 
 /// Magic bytes opening every serialized BVH.
@@ -121,7 +123,8 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
 /// Checks what traversal relies on: nodes are in breadth-first order, so
 /// the inner children met scanning nodes `0, 1, 2, …` (slots in order) are
 /// exactly nodes `1, 2, 3, …`, each once: that makes the nodes a tree with
-/// every child after its parent. Leaf ranges lie inside the item array;
+/// every child after its parent. Empty slots hold the empty box, which no
+/// ray enters. Leaf ranges lie inside the item array;
 /// depth ≤ [`MAX_DEPTH`]; every item is well formed. Linear time, constant
 /// memory, no allocation.
 ///
@@ -154,8 +157,11 @@ pub fn validate<P: Primitive>(
         if depth > MAX_DEPTH {
             return Err(LoadError::TooDeep);
         }
-        for c in node.children {
+        for (slot, c) in node.children.into_iter().enumerate() {
             if c.is_empty() {
+                if node.child_bounds(slot) != Aabb::EMPTY {
+                    return Err(LoadError::OpenEmptySlot { node: i });
+                }
                 continue;
             }
             if c.is_leaf() {

@@ -81,6 +81,12 @@ pub enum LoadError {
         /// The node holding the leaf.
         node: usize,
     },
+    /// An empty child slot whose box is not the empty box: traversal
+    /// relies on no ray ever entering an empty slot.
+    OpenEmptySlot {
+        /// The node holding the slot.
+        node: usize,
+    },
     /// Nodes reachable twice or not at all: not a tree.
     NotATree,
     /// Deeper than [`crate::MAX_DEPTH`].
@@ -105,6 +111,9 @@ impl fmt::Display for LoadError {
             Self::Misaligned => write!(f, "bytes not 16-byte aligned for zero-copy loading"),
             Self::BadChild { node } => write!(f, "node {node} has an invalid child reference"),
             Self::LeafOutOfRange { node } => write!(f, "node {node} has a leaf past the items"),
+            Self::OpenEmptySlot { node } => {
+                write!(f, "node {node} has an empty child slot with a non-empty box")
+            }
             Self::NotATree => write!(f, "nodes do not form a tree"),
             Self::TooDeep => write!(f, "BVH deeper than MAX_DEPTH"),
             Self::BadItem { item } => write!(f, "leaf item {item} is malformed"),

@@ -2,7 +2,7 @@
 
 use rt_core::{
     Ray,
-    internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG},
+    internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG, widen_far},
     intersect::WatertightRay,
 };
 
@@ -75,6 +75,30 @@ impl RayCtx {
                 F32x4::splat(wt.shear.z),
             ],
         })
+    }
+
+    /// [`rt_core::Aabb::admits_hit`] for the box `lo..hi` and this ray,
+    /// with the same arithmetic (so the same answer, bit for bit) but
+    /// without recomputing the reciprocal direction or checking the ray.
+    #[inline(always)]
+    #[must_use]
+    pub(crate) fn admits_hit(&self, lo: glam::Vec3, hi: glam::Vec3, t: f32) -> bool {
+        let (o, d) = (self.ray.origin, self.ray.direction);
+        let mut t0 = self.ray.t_min;
+        let mut t1 = widen_far(t);
+        for a in 0..3 {
+            let (near, far) = if d[a].is_sign_negative() { (hi[a], lo[a]) } else { (lo[a], hi[a]) };
+            let near = (near - o[a]) * self.inv1[a];
+            let far = widen_far((far - o[a]) * self.inv1[a]);
+            // `x > t0` is false for NaN, so NaN leaves the bound alone.
+            if near > t0 {
+                t0 = near;
+            }
+            if far < t1 {
+                t1 = far;
+            }
+        }
+        t0 <= t1
     }
 
     /// The ray these constants were made for.

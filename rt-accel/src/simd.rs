@@ -217,23 +217,28 @@ mod avx {
 #[cfg(target_arch = "x86_64")]
 pub(crate) use avx::F32x8;
 
-/// Hints the CPU to start loading the first two cache lines of `r`.
+/// Hints the CPU to start loading the cache lines of `bytes` bytes from
+/// `r` on (every line they touch, whatever `r`'s alignment).
 #[inline(always)]
-pub(crate) fn prefetch<T>(r: &T) {
+pub(crate) fn prefetch_bytes<T>(r: &T, bytes: usize) {
     #[cfg(target_arch = "x86_64")]
     {
         use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
         let p = (r as *const T).cast::<i8>();
-        // SAFETY: SSE is in the x86-64 baseline; a prefetch never faults,
-        // whatever the address (`wrapping_add` keeps the pointer arithmetic
-        // defined even past the object).
-        unsafe {
-            _mm_prefetch::<{ _MM_HINT_T0 }>(p);
-            _mm_prefetch::<{ _MM_HINT_T0 }>(p.wrapping_add(64));
+        let mut off = 0;
+        while off < bytes {
+            // SAFETY: SSE is in the x86-64 baseline; a prefetch never
+            // faults, whatever the address (`wrapping_add` keeps the
+            // pointer arithmetic defined even past the object).
+            unsafe { _mm_prefetch::<{ _MM_HINT_T0 }>(p.wrapping_add(off)) };
+            off += 64;
         }
+        // The last byte's line, when `r` is not line-aligned.
+        // SAFETY: as above.
+        unsafe { _mm_prefetch::<{ _MM_HINT_T0 }>(p.wrapping_add(bytes.max(1) - 1)) };
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = r;
+    let _ = (r, bytes);
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use crate::{
     Isa, RayCtx, UnsupportedIsa,
     node::{ChildRef, GROUPS, Node, WIDTH},
     prim::{BestHit, Primitive},
-    simd::prefetch,
+    simd::prefetch_bytes,
 };
 
 /// Deepest tree accepted by builders and loaders (root = depth 1).
@@ -224,15 +224,13 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 // `t_max` (found by the `bvh` fuzz target with
                 // `t_min = t_max`).
                 let (mask, _) = box_test::<AVX>(node, ctx, widen_far(t_max));
+                // Empty slots are never entered (see `closest_from`).
                 let mut m = mask;
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
                     m &= m - 1;
-                    let c = node.children[i];
-                    if !c.is_empty() {
-                        stack[sp] = c;
-                        sp += 1;
-                    }
+                    stack[sp] = node.children[i];
+                    sp += 1;
                 }
             }
             if sp == 0 {
@@ -246,11 +244,13 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     #[inline(always)]
     fn prefetch(&self, c: ChildRef) {
         if c.is_leaf() {
-            if let Some(it) = self.items.get(c.leaf_range().0) {
-                prefetch(it);
+            let (first, count) = c.leaf_range();
+            if let Some(it) = self.items.get(first) {
+                // The first two items: a leaf's usual size.
+                prefetch_bytes(it, count.min(2) * core::mem::size_of::<P>());
             }
         } else if let Some(n) = self.nodes.get(c.index()) {
-            prefetch(n);
+            prefetch_bytes(n, core::mem::size_of::<Node>());
         }
     }
 
@@ -342,26 +342,45 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 // may still hold an exact tie; widen the bound as the far
                 // planes are widened.
                 let bound = widen_far(best.t);
-                let (mut mask, tnear) = box_test::<AVX>(node, ctx, bound);
-                // Gather the hit, non-empty children with their entry distances.
-                let mut refs = [ChildRef::EMPTY; WIDTH];
-                let mut ts = [0.0f32; WIDTH];
-                let mut k = 0;
-                while mask != 0 {
+                let (mask, tnear) = box_test::<AVX>(node, ctx, bound);
+                // Empty slots hold the empty box, which no ray enters
+                // (`validate` rejects blobs where they do not): `mask` names
+                // real children only. One or two children (most nodes) take
+                // a short path; more are sorted.
+                if mask != 0 {
                     let i = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    let c = node.children[i];
-                    if !c.is_empty() {
-                        refs[k] = c;
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        cur = node.children[i];
+                        continue 'walk;
+                    }
+                    let j = rest.trailing_zeros() as usize;
+                    if rest & (rest - 1) == 0 {
+                        let (ci, cj) = (node.children[i], node.children[j]);
+                        let (near, far, t_far) = if tnear[j] < tnear[i] {
+                            (cj, ci, tnear[i])
+                        } else {
+                            (ci, cj, tnear[j])
+                        };
+                        self.prefetch(far);
+                        stack_ref[sp] = far;
+                        stack_t[sp] = t_far;
+                        sp += 1;
+                        cur = near;
+                        continue 'walk;
+                    }
+                    // Gather the hit children with their entry distances.
+                    let mut refs = [ChildRef::EMPTY; WIDTH];
+                    let mut ts = [0.0f32; WIDTH];
+                    let mut k = 0;
+                    let mut m = mask;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        refs[k] = node.children[i];
                         ts[k] = tnear[i];
                         k += 1;
                     }
-                }
-                if k == 1 {
-                    cur = refs[0];
-                    continue 'walk;
-                }
-                if k > 1 {
                     // Sort descending by entry distance (at most 8: insertion
                     // sort), push all but the nearest, descend into it.
                     for a in 1..k {

@@ -12,7 +12,6 @@
 use glam::Vec3;
 use rt_core::{
     Aabb, Hit, PrimKind, Ray,
-    internal::triangle_admits_hit,
     intersect::{TriangleHit, intersect_triangle_t, triangle_hit},
 };
 
@@ -67,18 +66,13 @@ impl TriPacket {
         self.prims[0] == u32::MAX
     }
 
-    /// The scalar test's final check ([`triangle_admits_hit`]) for a lane
+    /// The scalar test's final check ([`rt_core::internal::triangle_admits_hit`]) for a lane
     /// the SIMD test accepted; lanes failing it are redone by the scalar
     /// test, which may settle their `t` onto the box.
-    #[inline]
-    fn admits(&self, lane: usize, ray: &Ray, t: f32) -> bool {
-        triangle_admits_hit(
-            ray,
-            t,
-            self.vertex(lane, 0),
-            self.vertex(lane, 1),
-            self.vertex(lane, 2),
-        )
+    #[inline(always)]
+    fn admits(&self, lane: usize, ctx: &RayCtx, t: f32) -> bool {
+        let (a, b, c) = (self.vertex(lane, 0), self.vertex(lane, 1), self.vertex(lane, 2));
+        ctx.admits_hit(a.min(b).min(c), a.max(b).max(c), t)
     }
 
     #[inline]
@@ -139,7 +133,7 @@ impl Primitive for TriPacket {
         while ok != 0 {
             let lane = ok.trailing_zeros();
             ok &= ok - 1;
-            if self.admits(lane as usize, &ctx.ray, t[lane as usize]) {
+            if self.admits(lane as usize, ctx, t[lane as usize]) {
                 best.offer(t[lane as usize], self.prims[lane as usize], item, lane);
             } else {
                 // Rounded below its box: the scalar test settles it.
@@ -164,7 +158,7 @@ impl Primitive for TriPacket {
         while ok != 0 {
             let lane = ok.trailing_zeros() as usize;
             ok &= ok - 1;
-            if self.admits(lane, &ctx.ray, t[lane]) {
+            if self.admits(lane, ctx, t[lane]) {
                 return true;
             }
             edge |= 1 << lane;

@@ -16,7 +16,7 @@ use rt_accel::{
     build_capsules, build_spheres, build_triangles,
 };
 use rt_core::{
-    Ray,
+    Aabb, Ray,
     glam::Vec3,
     intersect::{Capsule, Sphere},
 };
@@ -472,6 +472,30 @@ fn huge_counts_are_rejected_without_overflow() {
     check::<TriPacket>(&tri_bvh().to_bytes());
     check::<SphereItem>(&sphere_bvh().to_bytes());
     check::<CapsuleItem>(&capsule_bvh().to_bytes());
+}
+
+/// An empty slot whose box a ray could enter is `OpenEmptySlot` naming the
+/// node, whatever the box (the whole scene's, a flat one, or a box with one
+/// empty axis only); the traversal never checks slots for emptiness, so
+/// such a blob must not load.
+#[test]
+fn empty_slots_with_boxes_are_rejected() {
+    let bytes = tri_bvh().to_bytes();
+    let nodes = nodes_of(&bytes);
+    let (i, s) = (0..nodes.len())
+        .flat_map(|i| (0..WIDTH).map(move |s| (i, s)))
+        .find(|&(i, s)| nodes[i].children[s].is_empty())
+        .expect("a node with an empty slot");
+    let scene = nodes[0].bounds();
+    let flat = Aabb::new(scene.min, Vec3::new(scene.max.x, scene.min.y, scene.max.z));
+    let one_axis =
+        Aabb::new(Vec3::new(0.0, f32::INFINITY, 0.0), Vec3::new(1.0, f32::NEG_INFINITY, 1.0));
+    for b in [scene, flat, one_axis] {
+        let bad = edit_nodes::<TriPacket>(&bytes, |nodes| nodes[i].set_child_bounds(s, b));
+        assert_eq!(load_err::<TriPacket>(&bad), LoadError::OpenEmptySlot { node: i }, "{b:?}");
+    }
+    // Every empty slot the builder writes holds the empty box.
+    assert!(load::<TriPacket>(&bytes).is_ok());
 }
 
 /// Nodes that cannot be reached from the root, and items without any node,
