@@ -1,0 +1,315 @@
+//! The exported GL and GLX entry points.
+//!
+//! Each one records the call ([`crate::record::Recorder`]) and forwards
+//! it, unchanged, to the real GL, so the program's own state, queries and
+//! raster output keep working. Recording never unwinds into the program:
+//! a panic is caught, logged once, and the call is forwarded as if rt-gl
+//! were not there. `glXSwapBuffers` ray traces the frame before the real
+//! swap (see [`crate::present`]).
+//!
+//! Pointer arguments are read only when non-null; GL's own rules for them
+//! are the real GL's business (the call is forwarded as given).
+
+// The exported symbols are `pub` for the linker, not for Rust callers.
+#![allow(non_snake_case, missing_docs, unreachable_pub, clippy::missing_safety_doc)]
+
+use core::ffi::{CStr, c_void};
+
+use glam::{Mat4, Vec3, Vec4};
+
+use crate::{
+    gl,
+    real::RealFn,
+    record::{Command, frustum, ortho, rotate, scale, translate},
+    with_recorder,
+};
+
+/// Reads `n` values of type `T` from `p` (none if `p` is null).
+///
+/// # Safety
+/// A non-null `p` must point at `n` readable values.
+unsafe fn read<T: Copy + Default, const N: usize>(p: *const T) -> Option<[T; N]> {
+    if p.is_null() {
+        return None;
+    }
+    // SAFETY: the caller guarantees N readable values.
+    Some(core::array::from_fn(|i| unsafe { *p.add(i) }))
+}
+
+fn v4(x: f32, y: f32, z: f32, w: f32) -> Command {
+    Command::Vertex(Vec4::new(x, y, z, w))
+}
+
+fn ub(c: u8) -> f32 {
+    f32::from(c) / 255.0
+}
+
+fn mat_f(m: [f32; 16]) -> Mat4 {
+    Mat4::from_cols_array(&m)
+}
+
+fn mat_d(m: [f64; 16]) -> Mat4 {
+    Mat4::from_cols_array(&m.map(|x| x as f32))
+}
+
+/// Lights and materials take 1 value for scalar names, 4 for vectors
+/// (3 for the spot direction).
+fn param_count(pname: u32) -> usize {
+    match pname {
+        gl::SPOT_DIRECTION => 3,
+        gl::AMBIENT
+        | gl::DIFFUSE
+        | gl::SPECULAR
+        | gl::POSITION
+        | gl::EMISSION
+        | gl::AMBIENT_AND_DIFFUSE
+        | gl::LIGHT_MODEL_AMBIENT => 4,
+        _ => 1,
+    }
+}
+
+/// Reads a light/material parameter vector of `pname`'s size.
+///
+/// # Safety
+/// A non-null `p` must point at that many values.
+unsafe fn params<T: Copy + Into<f64>>(pname: u32, p: *const T) -> Option<Vec4> {
+    if p.is_null() {
+        return None;
+    }
+    let n = param_count(pname);
+    let mut v = [0.0f32; 4];
+    for (i, x) in v.iter_mut().enumerate().take(n) {
+        // SAFETY: the caller guarantees `n` readable values.
+        *x = unsafe { (*p.add(i)).into() } as f32;
+    }
+    Some(Vec4::from_array(v))
+}
+
+/// Integer colour and material parameters map `[−2³¹, 2³¹ − 1]` to
+/// `[−1, 1]` (GL 2.1 §2.14.1); positions and scalars are taken as is.
+fn int_param(pname: u32, v: Vec4) -> Vec4 {
+    match pname {
+        gl::AMBIENT | gl::DIFFUSE | gl::SPECULAR | gl::EMISSION | gl::AMBIENT_AND_DIFFUSE
+        | gl::LIGHT_MODEL_AMBIENT => v / 2_147_483_647.0,
+        _ => v,
+    }
+}
+
+/// Defines exported entry points: record with the body, then forward.
+macro_rules! intercept {
+    ($($name:ident($($a:ident: $t:ty),*) $body:block)*) => {
+        $(
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn $name($($a: $t),*) {
+                static REAL: RealFn = RealFn::new(
+                    // SAFETY: the literal ends in its only NUL.
+                    unsafe { CStr::from_bytes_with_nul_unchecked(concat!(stringify!($name), "\0").as_bytes()) },
+                );
+                // The body only reads arguments (through null-checked
+                // pointers) and records.
+                #[allow(unused_unsafe, clippy::redundant_closure_call)]
+                let _ = (|| $body)();
+                if let Some(p) = REAL.get() {
+                    // SAFETY: the system GL's symbol of that name has this
+                    // signature (the GL specification's C prototype).
+                    let f: unsafe extern "C" fn($($t),*) = unsafe { core::mem::transmute(p) };
+                    // SAFETY: the program's own arguments, forwarded.
+                    unsafe { f($($a),*) }
+                }
+            }
+        )*
+
+        /// Our entry point for a GL function name, for `glXGetProcAddress`.
+        pub(crate) fn lookup(name: &[u8]) -> Option<unsafe extern "C" fn()> {
+            match name {
+                $(
+                    // SAFETY: only ever called back through its own
+                    // signature by a program that asked for this name.
+                    n if n == stringify!($name).as_bytes() => Some(unsafe {
+                        core::mem::transmute::<unsafe extern "C" fn($($t),*), unsafe extern "C" fn()>($name)
+                    }),
+                )*
+                _ => None,
+            }
+        }
+    };
+}
+
+/// Records a command.
+fn rec(c: Command) {
+    with_recorder(|r| r.command(c));
+}
+
+intercept! {
+    glBegin(mode: u32) { rec(Command::Begin(mode)) }
+    glEnd() { rec(Command::End) }
+
+    glVertex2f(x: f32, y: f32) { rec(v4(x, y, 0.0, 1.0)) }
+    glVertex2d(x: f64, y: f64) { rec(v4(x as f32, y as f32, 0.0, 1.0)) }
+    glVertex2i(x: i32, y: i32) { rec(v4(x as f32, y as f32, 0.0, 1.0)) }
+    glVertex2s(x: i16, y: i16) { rec(v4(x.into(), y.into(), 0.0, 1.0)) }
+    glVertex3f(x: f32, y: f32, z: f32) { rec(v4(x, y, z, 1.0)) }
+    glVertex3d(x: f64, y: f64, z: f64) { rec(v4(x as f32, y as f32, z as f32, 1.0)) }
+    glVertex3i(x: i32, y: i32, z: i32) { rec(v4(x as f32, y as f32, z as f32, 1.0)) }
+    glVertex3s(x: i16, y: i16, z: i16) { rec(v4(x.into(), y.into(), z.into(), 1.0)) }
+    glVertex4f(x: f32, y: f32, z: f32, w: f32) { rec(v4(x, y, z, w)) }
+    glVertex4d(x: f64, y: f64, z: f64, w: f64) { rec(v4(x as f32, y as f32, z as f32, w as f32)) }
+    glVertex2fv(v: *const f32) { if let Some([x, y]) = unsafe { read(v) } { rec(v4(x, y, 0.0, 1.0)) } }
+    glVertex2dv(v: *const f64) { if let Some([x, y]) = unsafe { read(v) } { rec(v4(x as f32, y as f32, 0.0, 1.0)) } }
+    glVertex3fv(v: *const f32) { if let Some([x, y, z]) = unsafe { read(v) } { rec(v4(x, y, z, 1.0)) } }
+    glVertex3dv(v: *const f64) { if let Some([x, y, z]) = unsafe { read(v) } { rec(v4(x as f32, y as f32, z as f32, 1.0)) } }
+    glVertex3iv(v: *const i32) { if let Some([x, y, z]) = unsafe { read(v) } { rec(v4(x as f32, y as f32, z as f32, 1.0)) } }
+    glVertex4fv(v: *const f32) { if let Some([x, y, z, w]) = unsafe { read(v) } { rec(v4(x, y, z, w)) } }
+    glVertex4dv(v: *const f64) { if let Some([x, y, z, w]) = unsafe { read(v) } { rec(v4(x as f32, y as f32, z as f32, w as f32)) } }
+
+    glNormal3f(x: f32, y: f32, z: f32) { rec(Command::Normal(Vec3::new(x, y, z))) }
+    glNormal3d(x: f64, y: f64, z: f64) { rec(Command::Normal(Vec3::new(x as f32, y as f32, z as f32))) }
+    glNormal3fv(v: *const f32) { if let Some(n) = unsafe { read(v) } { rec(Command::Normal(Vec3::from_array(n))) } }
+    glNormal3dv(v: *const f64) { if let Some(n) = unsafe { read(v) } { rec(Command::Normal(Vec3::from_array(n.map(|x: f64| x as f32)))) } }
+
+    glColor3f(r: f32, g: f32, b: f32) { rec(Command::Color(Vec4::new(r, g, b, 1.0))) }
+    glColor4f(r: f32, g: f32, b: f32, a: f32) { rec(Command::Color(Vec4::new(r, g, b, a))) }
+    glColor3d(r: f64, g: f64, b: f64) { rec(Command::Color(Vec4::new(r as f32, g as f32, b as f32, 1.0))) }
+    glColor4d(r: f64, g: f64, b: f64, a: f64) { rec(Command::Color(Vec4::new(r as f32, g as f32, b as f32, a as f32))) }
+    glColor3ub(r: u8, g: u8, b: u8) { rec(Command::Color(Vec4::new(ub(r), ub(g), ub(b), 1.0))) }
+    glColor4ub(r: u8, g: u8, b: u8, a: u8) { rec(Command::Color(Vec4::new(ub(r), ub(g), ub(b), ub(a)))) }
+    glColor3fv(v: *const f32) { if let Some([r, g, b]) = unsafe { read(v) } { rec(Command::Color(Vec4::new(r, g, b, 1.0))) } }
+    glColor4fv(v: *const f32) { if let Some(c) = unsafe { read(v) } { rec(Command::Color(Vec4::from_array(c))) } }
+    glColor3dv(v: *const f64) { if let Some([r, g, b]) = unsafe { read(v) } { rec(Command::Color(Vec4::new(r as f32, g as f32, b as f32, 1.0))) } }
+    glColor3ubv(v: *const u8) { if let Some([r, g, b]) = unsafe { read(v) } { rec(Command::Color(Vec4::new(ub(r), ub(g), ub(b), 1.0))) } }
+    glColor4ubv(v: *const u8) { if let Some(c) = unsafe { read(v) } { rec(Command::Color(Vec4::from_array(c.map(ub)))) } }
+
+    glNewList(list: u32, mode: u32) { with_recorder(|r| r.new_list(list, mode)) }
+    glEndList() { with_recorder(|r| r.end_list()) }
+    glCallList(list: u32) { rec(Command::CallList(list)) }
+    glCallLists(n: i32, ty: u32, lists: *const c_void) { call_lists(n, ty, lists) }
+    glListBase(base: u32) { with_recorder(|r| r.list_base(base)) }
+    glDeleteLists(list: u32, range: i32) { with_recorder(|r| r.delete_lists(list, range)) }
+
+    glMatrixMode(mode: u32) { rec(Command::MatrixMode(mode)) }
+    glLoadIdentity() { rec(Command::LoadIdentity) }
+    glLoadMatrixf(m: *const f32) { if let Some(m) = unsafe { read(m) } { rec(Command::LoadMatrix(mat_f(m))) } }
+    glLoadMatrixd(m: *const f64) { if let Some(m) = unsafe { read(m) } { rec(Command::LoadMatrix(mat_d(m))) } }
+    glMultMatrixf(m: *const f32) { if let Some(m) = unsafe { read(m) } { rec(Command::MultMatrix(mat_f(m))) } }
+    glMultMatrixd(m: *const f64) { if let Some(m) = unsafe { read(m) } { rec(Command::MultMatrix(mat_d(m))) } }
+    glTranslatef(x: f32, y: f32, z: f32) { rec(Command::MultMatrix(translate(Vec3::new(x, y, z)))) }
+    glTranslated(x: f64, y: f64, z: f64) { rec(Command::MultMatrix(translate(Vec3::new(x as f32, y as f32, z as f32)))) }
+    glRotatef(a: f32, x: f32, y: f32, z: f32) { rec(Command::MultMatrix(rotate(a, Vec3::new(x, y, z)))) }
+    glRotated(a: f64, x: f64, y: f64, z: f64) { rec(Command::MultMatrix(rotate(a as f32, Vec3::new(x as f32, y as f32, z as f32)))) }
+    glScalef(x: f32, y: f32, z: f32) { rec(Command::MultMatrix(scale(Vec3::new(x, y, z)))) }
+    glScaled(x: f64, y: f64, z: f64) { rec(Command::MultMatrix(scale(Vec3::new(x as f32, y as f32, z as f32)))) }
+    glFrustum(l: f64, r: f64, b: f64, t: f64, n: f64, f: f64) { if let Some(m) = frustum(l, r, b, t, n, f) { rec(Command::MultMatrix(m)) } }
+    glOrtho(l: f64, r: f64, b: f64, t: f64, n: f64, f: f64) { if let Some(m) = ortho(l, r, b, t, n, f) { rec(Command::MultMatrix(m)) } }
+    glPushMatrix() { rec(Command::PushMatrix) }
+    glPopMatrix() { rec(Command::PopMatrix) }
+
+    glViewport(x: i32, y: i32, w: i32, h: i32) { if w >= 0 && h >= 0 { with_recorder(|r| r.viewport = [x, y, w, h]); } }
+    glClearColor(r: f32, g: f32, b: f32, a: f32) { with_recorder(|rec| rec.clear_color = Vec4::new(r, g, b, a).clamp(Vec4::ZERO, Vec4::ONE)) }
+    glClear(mask: u32) { with_recorder(|r| r.clear(mask)) }
+    glEnable(cap: u32) { rec(Command::Enable(cap)) }
+    glDisable(cap: u32) { rec(Command::Disable(cap)) }
+    glShadeModel(mode: u32) { rec(Command::ShadeModel(mode)) }
+    glPointSize(size: f32) { rec(Command::PointSize(size)) }
+    glLineWidth(width: f32) { rec(Command::LineWidth(width)) }
+
+    glLightf(light: u32, pname: u32, v: f32) { rec(Command::Light(light, pname, Vec4::new(v, 0.0, 0.0, 0.0))) }
+    glLighti(light: u32, pname: u32, v: i32) { rec(Command::Light(light, pname, Vec4::new(v as f32, 0.0, 0.0, 0.0))) }
+    glLightfv(light: u32, pname: u32, v: *const f32) { if let Some(p) = unsafe { params(pname, v) } { rec(Command::Light(light, pname, p)) } }
+    glLightiv(light: u32, pname: u32, v: *const i32) { if let Some(p) = unsafe { params(pname, v) } { rec(Command::Light(light, pname, int_param(pname, p))) } }
+    glLightModelf(pname: u32, v: f32) { rec(Command::LightModel(pname, Vec4::new(v, 0.0, 0.0, 0.0))) }
+    glLightModeli(pname: u32, v: i32) { rec(Command::LightModel(pname, Vec4::new(v as f32, 0.0, 0.0, 0.0))) }
+    glLightModelfv(pname: u32, v: *const f32) { if let Some(p) = unsafe { params(pname, v) } { rec(Command::LightModel(pname, p)) } }
+    glMaterialf(face: u32, pname: u32, v: f32) { rec(Command::Material(face, pname, Vec4::new(v, 0.0, 0.0, 0.0))) }
+    glMateriali(face: u32, pname: u32, v: i32) { rec(Command::Material(face, pname, Vec4::new(v as f32, 0.0, 0.0, 0.0))) }
+    glMaterialfv(face: u32, pname: u32, v: *const f32) { if let Some(p) = unsafe { params(pname, v) } { rec(Command::Material(face, pname, p)) } }
+    glMaterialiv(face: u32, pname: u32, v: *const i32) { if let Some(p) = unsafe { params(pname, v) } { rec(Command::Material(face, pname, int_param(pname, p))) } }
+    glColorMaterial(face: u32, mode: u32) { rec(Command::ColorMaterial(face, mode)) }
+
+    glFlush() { crate::present::single_buffered_frame() }
+    glFinish() { crate::present::single_buffered_frame() }
+}
+
+/// `glCallLists`: reads `n` ids of type `ty` (GL 2.1 §5.4).
+fn call_lists(n: i32, ty: u32, lists: *const c_void) {
+    if n <= 0 || lists.is_null() {
+        return;
+    }
+    let n = n as usize;
+    // SAFETY (all arms): GL requires `lists` to hold `n` ids of type `ty`.
+    let ids: Vec<u32> = unsafe {
+        match ty {
+            gl::UNSIGNED_BYTE => (0..n).map(|i| u32::from(*lists.cast::<u8>().add(i))).collect(),
+            gl::BYTE => (0..n).map(|i| *lists.cast::<i8>().add(i) as u32).collect(),
+            gl::UNSIGNED_SHORT => (0..n).map(|i| u32::from(*lists.cast::<u16>().add(i))).collect(),
+            gl::SHORT => (0..n).map(|i| *lists.cast::<i16>().add(i) as u32).collect(),
+            gl::UNSIGNED_INT => (0..n).map(|i| *lists.cast::<u32>().add(i)).collect(),
+            gl::INT => (0..n).map(|i| *lists.cast::<i32>().add(i) as u32).collect(),
+            gl::FLOAT => (0..n).map(|i| *lists.cast::<f32>().add(i) as u32).collect(),
+            _ => return,
+        }
+    };
+    with_recorder(|r| r.call_lists(&ids));
+}
+
+/// `glXSwapBuffers`: ray trace the frame into the back buffer, then swap.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn glXSwapBuffers(dpy: *mut c_void, drawable: u64) {
+    crate::present::swap_frame();
+    // SAFETY: the program's own arguments, forwarded.
+    unsafe { crate::real::glXSwapBuffers(dpy, drawable) }
+}
+
+/// `glXGetProcAddress`: our entry points for the names we record, the
+/// real GL's for the rest.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn glXGetProcAddress(name: *const u8) -> Option<unsafe extern "C" fn()> {
+    // SAFETY: GLX passes a NUL-terminated name.
+    unsafe { proc_address(name, false) }
+}
+
+/// `glXGetProcAddressARB`: as [`glXGetProcAddress`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn glXGetProcAddressARB(name: *const u8) -> Option<unsafe extern "C" fn()> {
+    // SAFETY: GLX passes a NUL-terminated name.
+    unsafe { proc_address(name, true) }
+}
+
+/// # Safety
+/// `name` must be null or NUL-terminated.
+unsafe fn proc_address(name: *const u8, arb: bool) -> Option<unsafe extern "C" fn()> {
+    if name.is_null() {
+        return None;
+    }
+    // SAFETY: the caller guarantees a NUL-terminated string.
+    let bytes = unsafe { CStr::from_ptr(name.cast()) }.to_bytes();
+    match bytes {
+        b"glXSwapBuffers" => {
+            return Some(
+                // SAFETY: called back only through its own signature.
+                unsafe {
+                    core::mem::transmute::<
+                        unsafe extern "C" fn(*mut c_void, u64),
+                        unsafe extern "C" fn(),
+                    >(glXSwapBuffers)
+                },
+            );
+        }
+        b"glXGetProcAddress" | b"glXGetProcAddressARB" => {
+            // SAFETY: as above.
+            return Some(unsafe {
+                core::mem::transmute::<
+                    unsafe extern "C" fn(*const u8) -> Option<unsafe extern "C" fn()>,
+                    unsafe extern "C" fn(),
+                >(if arb { glXGetProcAddressARB } else { glXGetProcAddress })
+            });
+        }
+        _ => {}
+    }
+    if let Some(f) = lookup(bytes) {
+        return Some(f);
+    }
+    // SAFETY: forwarded as given.
+    unsafe {
+        if arb { crate::real::glXGetProcAddressARB(name) } else { crate::real::glXGetProcAddress(name) }
+    }
+}

@@ -1,0 +1,150 @@
+//! # rt-gl
+//!
+//! Ray tracing an unmodified OpenGL program. Built as a shared library and
+//! loaded with `LD_PRELOAD`, rt-gl stands between the program and the
+//! system's GL: it records the fixed-function geometry the program sends
+//! (immediate mode, display lists, matrices, lights, materials), forwards
+//! every call to the real GL, and at each `glXSwapBuffers` replaces the
+//! frame with a ray-traced one, written into the back buffer just before
+//! the real swap.
+//!
+//! ```sh
+//! cargo build --release -p rt-gl
+//! LD_PRELOAD=$PWD/target/release/librt_gl.so glxgears
+//! ```
+//!
+//! - [`record`]: the recorder, a mirror of GL's fixed-function state that
+//!   turns draws into geometry; display lists are recorded once and
+//!   instanced on every call.
+//! - [`render`]: the frame ray traced per pixel with GL's lighting
+//!   equation (`gl` mode) or with shadows and ambient occlusion too (`rt`).
+//! - The interposer itself (exported `gl*`/`glX*` symbols) is in the
+//!   `cdylib`; it never lets a panic reach the program, and any error
+//!   leaves that frame as the real GL drew it, logged once to stderr.
+//!
+//! Settings (environment variables, read once): `RT_GL_MODE=gl|rt`,
+//! `RT_GL_SHADOWS=0|1`, `RT_GL_AO=<rays per pixel>`, `RT_GL_THREADS=<n>`,
+//! `RT_GL_DUMP=<dir>` (each frame as `rt-NNNN.png`, counters in
+//! `counters.txt`), `RT_GL_DUMP_RASTER=1` (also what the real GL drew, as
+//! `raster-NNNN.png`), `RT_GL_STATS=1` (counters per frame on stderr).
+
+use std::{
+    collections::HashSet,
+    panic::{AssertUnwindSafe, catch_unwind},
+    path::PathBuf,
+    sync::{Mutex, OnceLock},
+};
+
+mod ffi;
+pub mod gl;
+mod present;
+mod real;
+pub mod record;
+pub mod render;
+
+use record::Recorder;
+use render::{Mode, Options};
+
+/// The settings read from the environment.
+#[derive(Debug)]
+pub struct Config {
+    /// Render options.
+    pub options: Options,
+    /// `RT_GL_DUMP`.
+    pub dump: Option<PathBuf>,
+    /// `RT_GL_DUMP_RASTER`.
+    pub dump_raster: bool,
+    /// `RT_GL_STATS`.
+    pub stats: bool,
+    /// `RT_GL_THREADS` (`None`: rayon's global pool, all cores).
+    pub pool: Option<rayon::ThreadPool>,
+}
+
+impl Config {
+    /// The settings from `var` (the environment, in the interposer).
+    /// Unreadable values are reported once and replaced by the default.
+    pub fn from_vars(var: impl Fn(&str) -> Option<String>) -> Self {
+        let mut options = Options::default();
+        let flag = |name: &str, default: bool| match var(name).as_deref() {
+            None => default,
+            Some("1" | "true" | "on" | "yes") => true,
+            Some("0" | "false" | "off" | "no") => false,
+            Some(v) => {
+                log_once(name, &format!("{name}={v}: expected 0 or 1; using {}", u8::from(default)));
+                default
+            }
+        };
+        match var("RT_GL_MODE").as_deref() {
+            None | Some("gl") => options.mode = Mode::Gl,
+            Some("rt") => options.mode = Mode::Rt,
+            Some(v) => log_once("RT_GL_MODE", &format!("RT_GL_MODE={v}: expected gl or rt; using gl")),
+        }
+        options.shadows = flag("RT_GL_SHADOWS", true);
+        if let Some(v) = var("RT_GL_AO") {
+            match v.parse::<u32>() {
+                Ok(n) if n <= 1024 => options.ao_samples = n,
+                _ => log_once("RT_GL_AO", &format!("RT_GL_AO={v}: expected 0..=1024 rays; using 8")),
+            }
+        }
+        let pool = var("RT_GL_THREADS").and_then(|v| match v.parse::<usize>() {
+            Ok(n) if n > 0 => rayon::ThreadPoolBuilder::new().num_threads(n).build().ok(),
+            _ => {
+                log_once("RT_GL_THREADS", &format!("RT_GL_THREADS={v}: expected a count > 0; using all cores"));
+                None
+            }
+        });
+        let dump = var("RT_GL_DUMP").filter(|d| !d.is_empty()).map(PathBuf::from);
+        if let Some(d) = &dump {
+            if let Err(e) = std::fs::create_dir_all(d) {
+                log_once("dump", &format!("cannot create {}: {e}", d.display()));
+            }
+        }
+        Self {
+            options,
+            dump,
+            dump_raster: flag("RT_GL_DUMP_RASTER", false),
+            stats: flag("RT_GL_STATS", false),
+            pool,
+        }
+    }
+}
+
+/// The settings, read from the environment on first use.
+pub(crate) fn config() -> &'static Config {
+    static CONFIG: OnceLock<Config> = OnceLock::new();
+    CONFIG.get_or_init(|| Config::from_vars(|k| std::env::var(k).ok()))
+}
+
+/// Logs `message` to stderr the first time `key` is seen.
+pub(crate) fn log_once(key: &str, message: &str) {
+    static SEEN: Mutex<Option<HashSet<String>>> = Mutex::new(None);
+    let mut seen = SEEN.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    if seen.get_or_insert_with(HashSet::new).insert(key.to_owned()) {
+        eprintln!("rt-gl: {message}");
+    }
+}
+
+/// Runs `f`, catching a panic (logged once): `None` if it panicked.
+pub(crate) fn catch<R>(f: impl FnOnce() -> R) -> Option<R> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(r) => Some(r),
+        Err(e) => {
+            let what = e
+                .downcast_ref::<&str>()
+                .map(|s| (*s).to_owned())
+                .or_else(|| e.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            log_once("panic", &format!("internal error, recording continues: {what}"));
+            None
+        }
+    }
+}
+
+/// Runs `f` on the process's recorder (`None` if it panicked).
+pub(crate) fn with_recorder<R>(f: impl FnOnce(&mut Recorder) -> R) -> Option<R> {
+    static RECORDER: Mutex<Option<Recorder>> = Mutex::new(None);
+    catch(|| {
+        let mut r = RECORDER.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        f(r.get_or_insert_with(Recorder::new))
+    })
+}

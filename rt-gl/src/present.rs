@@ -1,0 +1,159 @@
+//! The frame's end: ray trace what was recorded and write it into the
+//! program's back buffer through the real GL, saving and restoring every
+//! piece of state that touches.
+
+use core::ffi::c_void;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::{
+    config, gl, log_once, real,
+    render::{FrameScene, Image},
+    with_recorder,
+};
+
+/// Frames presented (numbers the dumps).
+static FRAME: AtomicU64 = AtomicU64::new(0);
+
+/// `glXSwapBuffers`: present the recorded frame, if any.
+pub(crate) fn swap_frame() {
+    present_frame(gl::BACK_BUFFER);
+}
+
+/// `glFlush`/`glFinish`: single-buffered windows show a frame here.
+pub(crate) fn single_buffered_frame() {
+    let mut double = 1u8;
+    // SAFETY: GL_DOUBLEBUFFER is one boolean.
+    unsafe { real::glGetBooleanv(0x0C32, &raw mut double) };
+    if double == 0 {
+        present_frame(0x0404);
+    }
+}
+
+fn present_frame(buffer: u32) {
+    let cfg = config();
+    let taken = with_recorder(|r| {
+        if r.compiling_only() {
+            return None;
+        }
+        let frame = r.end_frame();
+        let counters = r.counters;
+        Some((frame, r.lighting.clone(), r.projection(), r.viewport, r.clear_color, counters))
+    })
+    .flatten();
+    let Some((frame, lighting, projection, viewport, background, counters)) = taken else {
+        return;
+    };
+    let n = FRAME.fetch_add(1, Ordering::Relaxed);
+    let [x, y, w, h] = viewport;
+    if w <= 0 || h <= 0 {
+        return;
+    }
+    if cfg.dump_raster {
+        if let Some(dir) = &cfg.dump {
+            let img = read_back(buffer, viewport);
+            if let Err(e) = img.write_png(&dir.join(format!("raster-{n:04}.png"))) {
+                log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
+            }
+        }
+    }
+    let rendered = crate::catch(|| {
+        let scene = FrameScene::build(&frame)?;
+        let render = || scene.render(&lighting, projection, w as u32, h as u32, background, &cfg.options);
+        match &cfg.pool {
+            Some(pool) => pool.install(render),
+            None => render(),
+        }
+    });
+    let img = match rendered {
+        Some(Ok(img)) => img,
+        Some(Err(e)) => {
+            log_once("render", &format!("frame {n} left as rasterized: {e}"));
+            return;
+        }
+        None => return,
+    };
+    // SAFETY: `img` holds w·h RGBA pixels; the state touched is restored.
+    unsafe { draw(&img, x, y, buffer) };
+    if let Some(dir) = &cfg.dump {
+        if let Err(e) = img.write_png(&dir.join(format!("rt-{n:04}.png"))) {
+            log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
+        }
+        let c = counters;
+        let line = format!(
+            "frames={} list_builds={} list_reuses={} list_inline={} instances={} ignored={}\n",
+            c.frames, c.list_builds, c.list_reuses, c.list_inline, c.instances, c.ignored
+        );
+        let _ = std::fs::write(dir.join("counters.txt"), line);
+    }
+    if cfg.stats {
+        eprintln!("rt-gl: frame {n}: {:?}", counters);
+    }
+}
+
+/// What the real GL rasterized into `buffer` in the viewport.
+fn read_back(buffer: u32, [x, y, w, h]: [i32; 4]) -> Image {
+    let mut rgba = vec![0u8; 4 * w as usize * h as usize];
+    // SAFETY: `rgba` holds w·h RGBA pixels at pack alignment 1, row
+    // length 0 (set here, restored by the client-attribute pop).
+    unsafe {
+        real::glPushClientAttrib(gl::CLIENT_ALL_ATTRIB_BITS);
+        real::glPushAttrib(gl::ALL_ATTRIB_BITS);
+        real::glPixelStorei(gl::PACK_ALIGNMENT, 1);
+        real::glPixelStorei(gl::PACK_ROW_LENGTH, 0);
+        real::glReadBuffer(buffer);
+        real::glReadPixels(x, y, w, h, gl::RGBA, gl::UNSIGNED_BYTE, rgba.as_mut_ptr().cast());
+        real::glPopAttrib();
+        real::glPopClientAttrib();
+    }
+    Image { width: w as u32, height: h as u32, rgba }
+}
+
+/// Writes `img` at window position `(x, y)` with `glDrawPixels`.
+///
+/// # Safety
+/// A current GL context (the program's, at its swap).
+unsafe fn draw(img: &Image, x: i32, y: i32, _buffer: u32) {
+    // SAFETY: plain state changes, pushed and popped in pairs; the pixel
+    // pointer covers width·height RGBA pixels at unpack alignment 1.
+    unsafe {
+        real::glPushAttrib(gl::ALL_ATTRIB_BITS);
+        real::glPushClientAttrib(gl::CLIENT_ALL_ATTRIB_BITS);
+        real::glMatrixMode(gl::PROJECTION);
+        real::glPushMatrix();
+        real::glLoadIdentity();
+        real::glMatrixMode(gl::MODELVIEW);
+        real::glPushMatrix();
+        real::glLoadIdentity();
+        for cap in [
+            gl::LIGHTING,
+            gl::DEPTH_TEST,
+            gl::TEXTURE_2D,
+            gl::BLEND,
+            gl::FOG,
+            gl::ALPHA_TEST,
+            gl::STENCIL_TEST,
+            gl::CULL_FACE,
+        ] {
+            real::glDisable(cap);
+        }
+        real::glPixelStorei(gl::UNPACK_ALIGNMENT, 1);
+        real::glPixelStorei(gl::UNPACK_ROW_LENGTH, 0);
+        real::glPixelStorei(gl::UNPACK_SKIP_ROWS, 0);
+        real::glPixelStorei(gl::UNPACK_SKIP_PIXELS, 0);
+        real::glPixelZoom(1.0, 1.0);
+        real::glWindowPos2i(x, y);
+        real::glDrawPixels(
+            img.width as i32,
+            img.height as i32,
+            gl::RGBA,
+            gl::UNSIGNED_BYTE,
+            img.rgba.as_ptr().cast::<c_void>(),
+        );
+        real::glMatrixMode(gl::MODELVIEW);
+        real::glPopMatrix();
+        real::glMatrixMode(gl::PROJECTION);
+        real::glPopMatrix();
+        real::glPopClientAttrib();
+        real::glPopAttrib();
+    }
+}

@@ -1,0 +1,354 @@
+//! Ray tracing a recorded frame: one ray per pixel through the program's
+//! own projection, shaded with the fixed-function lighting equation
+//! (OpenGL 2.1 specification §2.14.1) evaluated per pixel; in
+//! [`Mode::Rt`] with shadow rays toward every light and ambient
+//! occlusion on the ambient terms.
+//!
+//! Why not rt-surface's shading: GL's material has separate ambient,
+//! diffuse, specular and emissive colours, unlit primitives show their
+//! colour as is, and positional lights attenuate by GL's
+//! `1/(k_c + k_l·d + k_q·d²)`, not `1/d²`. Reproducing the program's
+//! own image (the `gl` mode) needs exactly GL's equation; rt-accel's BVH
+//! answers the rays.
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use rayon::prelude::*;
+use rt_accel::{BuildError, BuildParams, Scene, build_capsules, build_spheres, build_triangles};
+use rt_core::{
+    Hit, PrimKind, Ray, SceneQuery,
+    camera::cosine_hemisphere,
+    intersect::{Capsule, Sphere},
+    sampling, spawn_ray, spawn_ray_to,
+};
+
+use crate::record::{Frame, Geometry, Lighting, Shading};
+
+/// How frames are shaded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// The fixed-function lighting model, per pixel: comparable with the
+    /// program's own image.
+    Gl,
+    /// `Gl` plus shadows and ambient occlusion.
+    Rt,
+}
+
+/// Render settings (from the `RT_GL_*` environment variables).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// Shading mode.
+    pub mode: Mode,
+    /// Shadow rays toward every enabled light (`Rt` mode).
+    pub shadows: bool,
+    /// Ambient-occlusion rays per pixel (`Rt` mode; 0: off).
+    pub ao_samples: u32,
+    /// Longest AO ray, as a fraction of the scene's diagonal.
+    pub ao_distance: f32,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self { mode: Mode::Gl, shadows: true, ao_samples: 8, ao_distance: 0.2 }
+    }
+}
+
+/// An RGBA8 image, rows bottom to top (GL's order).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `4 · width · height` bytes, bottom row first.
+    pub rgba: Vec<u8>,
+}
+
+impl Image {
+    /// The pixel at `(x, y)`, `y` counted from the bottom.
+    #[must_use]
+    pub fn get(&self, x: u32, y: u32) -> Option<[u8; 4]> {
+        if x >= self.width || y >= self.height {
+            return None;
+        }
+        let i = 4 * (y as usize * self.width as usize + x as usize);
+        self.rgba.get(i..i + 4).map(|p| [p[0], p[1], p[2], p[3]])
+    }
+
+    /// Writes the image as an opaque PNG (top row first, as PNG stores it).
+    ///
+    /// # Errors
+    /// The file cannot be created or written.
+    pub fn write_png(&self, path: &std::path::Path) -> std::io::Result<()> {
+        let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+        let mut enc = png::Encoder::new(file, self.width, self.height);
+        enc.set_color(png::ColorType::Rgba);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().map_err(std::io::Error::other)?;
+        let row = 4 * self.width as usize;
+        // Opaque: what GL rasterizes into a window without alpha reads
+        // back as alpha 1, and a transparent background hides the figure.
+        let top_down: Vec<u8> = self
+            .rgba
+            .chunks(row.max(1))
+            .rev()
+            .flat_map(|r| r.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2], 255]))
+            .collect();
+        w.write_image_data(&top_down).map_err(std::io::Error::other)
+    }
+}
+
+/// Why a frame could not be ray traced (the program's own image stays).
+#[derive(Clone, Debug, PartialEq)]
+pub enum RenderError {
+    /// The BVH could not be built (e.g. a vertex overflowed to infinity).
+    Build(BuildError),
+    /// The projection matrix is singular or not finite.
+    BadProjection,
+    /// The viewport is empty or larger than 16384 × 16384.
+    BadViewport,
+}
+
+impl core::fmt::Display for RenderError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Build(e) => write!(f, "building the frame's BVH: {e}"),
+            Self::BadProjection => write!(f, "projection matrix is singular or not finite"),
+            Self::BadViewport => write!(f, "viewport empty or larger than 16384 × 16384"),
+        }
+    }
+}
+
+impl core::error::Error for RenderError {}
+
+impl From<BuildError> for RenderError {
+    fn from(e: BuildError) -> Self {
+        Self::Build(e)
+    }
+}
+
+/// A frame's geometry in eye space behind BVHs.
+pub struct FrameScene {
+    geometry: Geometry,
+    scene: Scene,
+    diagonal: f32,
+}
+
+impl FrameScene {
+    /// Builds the BVHs over everything `frame` drew.
+    ///
+    /// # Errors
+    /// [`RenderError::Build`] if a primitive is not finite.
+    pub fn build(frame: &Frame) -> Result<Self, RenderError> {
+        let geometry = frame.flatten();
+        let params = BuildParams::fast();
+        let g = &geometry;
+        let spheres: Vec<Sphere> =
+            g.spheres.iter().map(|&(v, r, _)| Sphere::new(g.positions[v as usize], r)).collect();
+        let tubes: Vec<Capsule> = g
+            .tubes
+            .iter()
+            .map(|&([a, b], r, _)| Capsule::new(g.positions[a as usize], g.positions[b as usize], r))
+            .collect();
+        let scene = Scene {
+            triangles: build_triangles(&g.positions, &g.triangles, &params)?,
+            spheres: build_spheres(&spheres, &params)?,
+            capsules: build_capsules(&tubes, &params)?,
+        };
+        let b = scene
+            .triangles
+            .as_ref()
+            .bounds()
+            .union(scene.spheres.as_ref().bounds())
+            .union(scene.capsules.as_ref().bounds());
+        let diagonal = if b.is_empty() { 0.0 } else { (b.max - b.min).length() };
+        Ok(Self { geometry, scene, diagonal })
+    }
+
+    /// The geometry the BVHs hold.
+    #[must_use]
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+
+    /// Ray traces the frame at `width × height` through `projection`,
+    /// `background` where nothing is hit.
+    ///
+    /// # Errors
+    /// [`RenderError::BadProjection`] or [`RenderError::BadViewport`].
+    pub fn render(
+        &self,
+        lighting: &Lighting,
+        projection: Mat4,
+        width: u32,
+        height: u32,
+        background: Vec4,
+        opts: &Options,
+    ) -> Result<Image, RenderError> {
+        if width == 0 || height == 0 || width > 16384 || height > 16384 {
+            return Err(RenderError::BadViewport);
+        }
+        let inv = projection.inverse();
+        if projection.determinant() == 0.0 || !inv.is_finite() {
+            return Err(RenderError::BadProjection);
+        }
+        let bg = to_rgba8(background);
+        let mut rgba = vec![0u8; 4 * width as usize * height as usize];
+        rgba.par_chunks_mut(4 * width as usize).enumerate().for_each(|(y, row)| {
+            for (x, px) in row.chunks_exact_mut(4).enumerate() {
+                let ndc = Vec2::new(
+                    2.0 * (x as f32 + 0.5) / width as f32 - 1.0,
+                    2.0 * (y as f32 + 0.5) / height as f32 - 1.0,
+                );
+                let near = inv.project_point3(ndc.extend(-1.0));
+                let far = inv.project_point3(ndc.extend(1.0));
+                // Parameter 0..1 spans the near to the far plane: GL's clipping.
+                let ray = Ray::with_range(near, far - near, 0.0, 1.0);
+                let c = match self.scene.closest_hit(&ray) {
+                    Some(hit) => {
+                        let seed = (y as u64) << 32 | x as u64;
+                        to_rgba8(self.shade(&ray, &hit, lighting, opts, seed))
+                    }
+                    None => bg,
+                };
+                px.copy_from_slice(&c);
+            }
+        });
+        Ok(Image { width, height, rgba })
+    }
+
+    /// The shading, colour and normal at a hit.
+    fn surface(&self, hit: &Hit) -> (Shading, Vec4, Vec3) {
+        let g = &self.geometry;
+        let p = hit.prim as usize;
+        match hit.kind {
+            PrimKind::Triangle => {
+                let [a, b, c] = g.triangles[p].map(|i| i as usize);
+                let (s, pv) = g.triangle_info[p];
+                let sh = g.shadings[s as usize];
+                if sh.flat {
+                    (sh, g.colors[pv as usize], g.normals[pv as usize])
+                } else {
+                    let w = Vec3::new(1.0 - hit.uv.x - hit.uv.y, hit.uv.x, hit.uv.y);
+                    let col = w.x * g.colors[a] + w.y * g.colors[b] + w.z * g.colors[c];
+                    let n = w.x * g.normals[a] + w.y * g.normals[b] + w.z * g.normals[c];
+                    (sh, col, n)
+                }
+            }
+            PrimKind::Sphere => {
+                let (v, _, s) = g.spheres[p];
+                (g.shadings[s as usize], g.colors[v as usize], hit.normal)
+            }
+            PrimKind::Capsule => {
+                let ([a, b], _, s) = g.tubes[p];
+                let (pa, pb) = (g.positions[a as usize], g.positions[b as usize]);
+                let d = pb - pa;
+                let f = if d == Vec3::ZERO {
+                    0.0
+                } else {
+                    ((hit.position - pa).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+                };
+                let col = g.colors[a as usize].lerp(g.colors[b as usize], f);
+                (g.shadings[s as usize], col, hit.normal)
+            }
+        }
+    }
+
+    /// GL's lighting equation at `hit`, per pixel.
+    fn shade(&self, ray: &Ray, hit: &Hit, lighting: &Lighting, opts: &Options, seed: u64) -> Vec4 {
+        let (sh, color, normal) = self.surface(hit);
+        if !sh.lit {
+            return color;
+        }
+        // Spheres and tubes carry their own normal; triangles the one
+        // the program gave (GL_NORMALIZE or not, lighting wants it unit).
+        let mut n = normal.normalize_or_zero();
+        if n == Vec3::ZERO {
+            n = hit.normal;
+        }
+        // GL decides the side by the window-space winding: the geometric
+        // normal against the eye ray.
+        let back = hit.normal.dot(ray.direction) > 0.0;
+        if back && lighting.two_side {
+            n = -n;
+        }
+        let geo_n = if back { -hit.normal } else { hit.normal };
+        let m = sh.material_with(color);
+        let rt = opts.mode == Mode::Rt;
+        let ambient_visibility = if rt && opts.ao_samples > 0 && self.diagonal > 0.0 {
+            self.ambient_visibility(hit, geo_n, opts, seed)
+        } else {
+            1.0
+        };
+        let p = hit.position;
+        let eye = Vec3::Z; // GL's default infinite viewer
+        let mut c = m.emission + m.ambient * lighting.model_ambient * ambient_visibility;
+        for l in lighting.lights.iter().filter(|l| l.enabled) {
+            let (to_light, attenuation, target) = if l.position.w == 0.0 {
+                (l.position.truncate().normalize_or_zero(), 1.0, None)
+            } else {
+                let lp = l.position.truncate() / l.position.w;
+                let d = lp - p;
+                let dist = d.length();
+                let k = l.attenuation;
+                let att = 1.0 / (k.x + k.y * dist + k.z * dist * dist);
+                (d / dist, if att.is_finite() { att } else { 0.0 }, Some(lp))
+            };
+            let spot = if l.spot_cutoff >= 180.0 {
+                1.0
+            } else {
+                let cos = (-to_light).dot(l.spot_direction.normalize_or_zero());
+                if cos < l.spot_cutoff.to_radians().cos() {
+                    0.0
+                } else {
+                    cos.max(0.0).powf(l.spot_exponent)
+                }
+            };
+            let k = attenuation * spot;
+            if k == 0.0 || !to_light.is_finite() {
+                continue;
+            }
+            c += k * l.ambient * m.ambient * ambient_visibility;
+            let ndl = n.dot(to_light);
+            if ndl <= 0.0 {
+                continue;
+            }
+            if rt && opts.shadows && geo_n.dot(to_light) > 0.0 {
+                let shadow = match target {
+                    None => spawn_ray(p, hit.position_error, geo_n, to_light),
+                    Some(lp) => spawn_ray_to(p, hit.position_error, geo_n, lp),
+                };
+                if self.scene.occluded(&shadow) {
+                    continue;
+                }
+            }
+            c += k * ndl * l.diffuse * m.diffuse;
+            let h = (to_light + eye).normalize_or_zero();
+            let ndh = n.dot(h).max(0.0);
+            let spec = if m.shininess == 0.0 { 1.0 } else { ndh.powf(m.shininess) };
+            c += k * spec * l.specular * m.specular;
+        }
+        c.truncate().extend(m.diffuse.w)
+    }
+
+    /// The unoccluded fraction of cosine-distributed rays about `n`,
+    /// seeded by the pixel (the same image at any thread count).
+    fn ambient_visibility(&self, hit: &Hit, n: Vec3, opts: &Options, seed: u64) -> f32 {
+        let mut rng = sampling::rng_from_seed(seed ^ 0x9e37_79b9_7f4a_7c15);
+        let (t, b) = n.any_orthonormal_pair();
+        let reach = opts.ao_distance * self.diagonal;
+        let mut open = 0;
+        for _ in 0..opts.ao_samples {
+            let l = cosine_hemisphere(sampling::uniform2(&mut rng));
+            let mut r = spawn_ray(hit.position, hit.position_error, n, t * l.x + b * l.y + n * l.z);
+            r.t_max = reach;
+            if !self.scene.occluded(&r) {
+                open += 1;
+            }
+        }
+        open as f32 / opts.ao_samples as f32
+    }
+}
+
+fn to_rgba8(c: Vec4) -> [u8; 4] {
+    c.to_array().map(|x| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)
+}
