@@ -20,7 +20,7 @@ use glam::{Mat4, Vec3, Vec4};
 use crate::{
     gl,
     real::RealFn,
-    record::{Command, frustum, ortho, rotate, scale, translate},
+    record::{Command, arrays, frustum, ortho, rotate, scale, translate},
     with_recorder,
 };
 
@@ -89,7 +89,11 @@ unsafe fn params<T: Copy + Into<f64>>(pname: u32, p: *const T) -> Option<Vec4> {
 /// `[−1, 1]` (GL 2.1 §2.14.1); positions and scalars are taken as is.
 fn int_param(pname: u32, v: Vec4) -> Vec4 {
     match pname {
-        gl::AMBIENT | gl::DIFFUSE | gl::SPECULAR | gl::EMISSION | gl::AMBIENT_AND_DIFFUSE
+        gl::AMBIENT
+        | gl::DIFFUSE
+        | gl::SPECULAR
+        | gl::EMISSION
+        | gl::AMBIENT_AND_DIFFUSE
         | gl::LIGHT_MODEL_AMBIENT => v / 2_147_483_647.0,
         _ => v,
     }
@@ -125,6 +129,7 @@ macro_rules! intercept {
                 $(
                     // SAFETY: only ever called back through its own
                     // signature by a program that asked for this name.
+                    #[allow(clippy::useless_transmute)]
                     n if n == stringify!($name).as_bytes() => Some(unsafe {
                         core::mem::transmute::<unsafe extern "C" fn($($t),*), unsafe extern "C" fn()>($name)
                     }),
@@ -225,8 +230,90 @@ intercept! {
     glMaterialiv(face: u32, pname: u32, v: *const i32) { if let Some(p) = unsafe { params(pname, v) } { rec(Command::Material(face, pname, int_param(pname, p))) } }
     glColorMaterial(face: u32, mode: u32) { rec(Command::ColorMaterial(face, mode)) }
 
+    glEnableClientState(array: u32) { with_recorder(|r| r.client_state(array, true)); }
+    glDisableClientState(array: u32) { with_recorder(|r| r.client_state(array, false)); }
+    glVertexPointer(size: i32, ty: u32, stride: i32, p: *const c_void) { with_recorder(|r| r.pointer(arrays::VERTEX_ARRAY, size, ty, stride, p as usize)); }
+    glNormalPointer(ty: u32, stride: i32, p: *const c_void) { with_recorder(|r| r.pointer(arrays::NORMAL_ARRAY, 3, ty, stride, p as usize)); }
+    glColorPointer(size: i32, ty: u32, stride: i32, p: *const c_void) { with_recorder(|r| r.pointer(arrays::COLOR_ARRAY, size, ty, stride, p as usize)); }
+    glBindBuffer(target: u32, buffer: u32) { with_recorder(|r| r.bind_buffer(target, buffer)); }
+    glBindBufferARB(target: u32, buffer: u32) { with_recorder(|r| r.bind_buffer(target, buffer)); }
+    glBufferData(target: u32, size: isize, data: *const c_void, usage: u32) { buffer_data(target, size, data, usage) }
+    glBufferDataARB(target: u32, size: isize, data: *const c_void, usage: u32) { buffer_data(target, size, data, usage) }
+    glBufferSubData(target: u32, offset: isize, size: isize, data: *const c_void) { buffer_sub_data(target, offset, size, data) }
+    glBufferSubDataARB(target: u32, offset: isize, size: isize, data: *const c_void) { buffer_sub_data(target, offset, size, data) }
+    glDeleteBuffers(n: i32, ids: *const u32) { delete_buffers(n, ids) }
+    glDeleteBuffersARB(n: i32, ids: *const u32) { delete_buffers(n, ids) }
+    // SAFETY (the draws): GL requires enabled client arrays and client
+    // indices to cover what is drawn; the recorder reads no more.
+    glDrawArrays(mode: u32, first: i32, count: i32) { with_recorder(|r| unsafe { r.draw_arrays(mode, first, count) }); }
+    glDrawElements(mode: u32, count: i32, ty: u32, indices: *const c_void) { with_recorder(|r| unsafe { r.draw_elements(mode, count, ty, indices as usize) }); }
+    glDrawRangeElements(mode: u32, start: u32, end: u32, count: i32, ty: u32, indices: *const c_void) { let _ = (start, end); with_recorder(|r| unsafe { r.draw_elements(mode, count, ty, indices as usize) }); }
+    glMultiDrawArrays(mode: u32, first: *const i32, count: *const i32, n: i32) { multi_draw_arrays(mode, first, count, n) }
+    glMultiDrawElements(mode: u32, count: *const i32, ty: u32, indices: *const *const c_void, n: i32) { multi_draw_elements(mode, count, ty, indices, n) }
+
     glFlush() { crate::present::single_buffered_frame() }
     glFinish() { crate::present::single_buffered_frame() }
+}
+
+fn buffer_data(target: u32, size: isize, data: *const c_void, _usage: u32) {
+    let Ok(size) = usize::try_from(size) else { return };
+    let bytes = (!data.is_null() && size <= arrays::MAX_BUFFER_BYTES)
+        // SAFETY: GL requires `data` to hold `size` bytes.
+        .then(|| unsafe { core::slice::from_raw_parts(data.cast::<u8>(), size) });
+    with_recorder(|r| r.buffer_data(target, size, bytes));
+}
+
+fn buffer_sub_data(target: u32, offset: isize, size: isize, data: *const c_void) {
+    let (Ok(offset), Ok(size)) = (usize::try_from(offset), usize::try_from(size)) else { return };
+    if data.is_null() || size > arrays::MAX_BUFFER_BYTES {
+        return;
+    }
+    // SAFETY: GL requires `data` to hold `size` bytes.
+    let bytes = unsafe { core::slice::from_raw_parts(data.cast::<u8>(), size) };
+    with_recorder(|r| r.buffer_sub_data(target, offset, bytes));
+}
+
+fn delete_buffers(n: i32, ids: *const u32) {
+    let Ok(n) = usize::try_from(n) else { return };
+    if ids.is_null() {
+        return;
+    }
+    // SAFETY: GL requires `ids` to hold `n` names.
+    let ids = unsafe { core::slice::from_raw_parts(ids, n) };
+    with_recorder(|r| r.delete_buffers(ids));
+}
+
+fn multi_draw_arrays(mode: u32, first: *const i32, count: *const i32, n: i32) {
+    let Ok(n) = usize::try_from(n) else { return };
+    if first.is_null() || count.is_null() {
+        return;
+    }
+    for i in 0..n {
+        // SAFETY: GL requires both arrays to hold `n` values, and the
+        // client arrays to cover each range.
+        unsafe { with_recorder(|r| r.draw_arrays(mode, *first.add(i), *count.add(i))) };
+    }
+}
+
+fn multi_draw_elements(
+    mode: u32,
+    count: *const i32,
+    ty: u32,
+    indices: *const *const c_void,
+    n: i32,
+) {
+    let Ok(n) = usize::try_from(n) else { return };
+    if count.is_null() || indices.is_null() {
+        return;
+    }
+    for i in 0..n {
+        // SAFETY: GL requires both arrays to hold `n` values, and each
+        // index list to hold its count.
+        unsafe {
+            let (c, p) = (*count.add(i), *indices.add(i) as usize);
+            with_recorder(|r| r.draw_elements(mode, c, ty, p));
+        }
+    }
 }
 
 /// `glCallLists`: reads `n` ids of type `ty` (GL 2.1 §5.4).
@@ -310,6 +397,10 @@ unsafe fn proc_address(name: *const u8, arb: bool) -> Option<unsafe extern "C" f
     }
     // SAFETY: forwarded as given.
     unsafe {
-        if arb { crate::real::glXGetProcAddressARB(name) } else { crate::real::glXGetProcAddress(name) }
+        if arb {
+            crate::real::glXGetProcAddressARB(name)
+        } else {
+            crate::real::glXGetProcAddress(name)
+        }
     }
 }

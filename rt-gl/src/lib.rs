@@ -28,6 +28,10 @@
 //! `counters.txt`), `RT_GL_DUMP_RASTER=1` (also what the real GL drew, as
 //! `raster-NNNN.png`), `RT_GL_STATS=1` (counters per frame on stderr).
 
+// A std-only library loaded into programs: the no_std import lints of the
+// workspace do not apply.
+#![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
+
 use std::{
     collections::HashSet,
     panic::{AssertUnwindSafe, catch_unwind},
@@ -70,34 +74,42 @@ impl Config {
             Some("1" | "true" | "on" | "yes") => true,
             Some("0" | "false" | "off" | "no") => false,
             Some(v) => {
-                log_once(name, &format!("{name}={v}: expected 0 or 1; using {}", u8::from(default)));
+                log_once(
+                    name,
+                    &format!("{name}={v}: expected 0 or 1; using {}", u8::from(default)),
+                );
                 default
             }
         };
         match var("RT_GL_MODE").as_deref() {
             None | Some("gl") => options.mode = Mode::Gl,
             Some("rt") => options.mode = Mode::Rt,
-            Some(v) => log_once("RT_GL_MODE", &format!("RT_GL_MODE={v}: expected gl or rt; using gl")),
+            Some(v) => {
+                log_once("RT_GL_MODE", &format!("RT_GL_MODE={v}: expected gl or rt; using gl"))
+            }
         }
         options.shadows = flag("RT_GL_SHADOWS", true);
         if let Some(v) = var("RT_GL_AO") {
             match v.parse::<u32>() {
                 Ok(n) if n <= 1024 => options.ao_samples = n,
-                _ => log_once("RT_GL_AO", &format!("RT_GL_AO={v}: expected 0..=1024 rays; using 8")),
+                _ => {
+                    log_once("RT_GL_AO", &format!("RT_GL_AO={v}: expected 0..=1024 rays; using 8"))
+                }
             }
         }
         let pool = var("RT_GL_THREADS").and_then(|v| match v.parse::<usize>() {
             Ok(n) if n > 0 => rayon::ThreadPoolBuilder::new().num_threads(n).build().ok(),
             _ => {
-                log_once("RT_GL_THREADS", &format!("RT_GL_THREADS={v}: expected a count > 0; using all cores"));
+                log_once(
+                    "RT_GL_THREADS",
+                    &format!("RT_GL_THREADS={v}: expected a count > 0; using all cores"),
+                );
                 None
             }
         });
         let dump = var("RT_GL_DUMP").filter(|d| !d.is_empty()).map(PathBuf::from);
-        if let Some(d) = &dump {
-            if let Err(e) = std::fs::create_dir_all(d) {
-                log_once("dump", &format!("cannot create {}: {e}", d.display()));
-            }
+        if let Some(Err(e)) = dump.as_ref().map(std::fs::create_dir_all) {
+            log_once("dump", &format!("cannot create the dump directory: {e}"));
         }
         Self {
             options,

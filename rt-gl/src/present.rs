@@ -48,17 +48,16 @@ fn present_frame(buffer: u32) {
     if w <= 0 || h <= 0 {
         return;
     }
-    if cfg.dump_raster {
-        if let Some(dir) = &cfg.dump {
-            let img = read_back(buffer, viewport);
-            if let Err(e) = img.write_png(&dir.join(format!("raster-{n:04}.png"))) {
-                log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
-            }
+    if let (true, Some(dir)) = (cfg.dump_raster, &cfg.dump) {
+        let img = read_back(buffer, viewport);
+        if let Err(e) = img.write_png(&dir.join(format!("raster-{n:04}.png"))) {
+            log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
         }
     }
     let rendered = crate::catch(|| {
         let scene = FrameScene::build(&frame)?;
-        let render = || scene.render(&lighting, projection, w as u32, h as u32, background, &cfg.options);
+        let render =
+            || scene.render(&lighting, projection, w as u32, h as u32, background, &cfg.options);
         match &cfg.pool {
             Some(pool) => pool.install(render),
             None => render(),
@@ -80,8 +79,16 @@ fn present_frame(buffer: u32) {
         }
         let c = counters;
         let line = format!(
-            "frames={} list_builds={} list_reuses={} list_inline={} instances={} ignored={}\n",
-            c.frames, c.list_builds, c.list_reuses, c.list_inline, c.instances, c.ignored
+            "frames={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_inline={} instances={} ignored={}\n",
+            c.frames,
+            c.list_builds,
+            c.list_reuses,
+            c.list_inline,
+            c.draw_builds,
+            c.draw_reuses,
+            c.draw_inline,
+            c.instances,
+            c.ignored
         );
         let _ = std::fs::write(dir.join("counters.txt"), line);
     }

@@ -21,7 +21,14 @@ impl RealFn {
         let p = *self.ptr.get_or_init(|| {
             // SAFETY: `name` is a NUL-terminated string; RTLD_NEXT asks the
             // dynamic linker for the next definition after this library.
-            unsafe { libc::dlsym(libc::RTLD_NEXT, self.name.as_ptr()) as usize }
+            let p = unsafe { libc::dlsym(libc::RTLD_NEXT, self.name.as_ptr()) } as usize;
+            if p != 0 || self.name.to_bytes().starts_with(b"glX") {
+                return p;
+            }
+            // Extensions and newer entry points a libGL may not export:
+            // ask GLX, as programs do.
+            // SAFETY: a NUL-terminated name.
+            unsafe { glXGetProcAddressARB(self.name.as_ptr().cast()) }.map_or(0, |f| f as usize)
         });
         (p != 0).then_some(p as *const c_void)
     }

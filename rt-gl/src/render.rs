@@ -147,7 +147,9 @@ impl FrameScene {
         let tubes: Vec<Capsule> = g
             .tubes
             .iter()
-            .map(|&([a, b], r, _)| Capsule::new(g.positions[a as usize], g.positions[b as usize], r))
+            .map(|&([a, b], r, _)| {
+                Capsule::new(g.positions[a as usize], g.positions[b as usize], r)
+            })
             .collect();
         let scene = Scene {
             triangles: build_triangles(&g.positions, &g.triangles, &params)?,

@@ -22,6 +22,11 @@ use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use crate::gl;
 
+pub mod arrays;
+
+pub use arrays::ArrayPointer;
+use arrays::{ArrayState, DrawKey};
+
 /// One recorded call, as display lists store them.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
@@ -241,9 +246,11 @@ impl Geometry {
         self.colors.extend_from_slice(&other.colors);
         self.triangles.extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
         self.triangle_info.extend(other.triangle_info.iter().map(|&(s, p)| (s + sbase, p + base)));
-        self.spheres.extend(other.spheres.iter().map(|&(v, r, s)| (v + base, r * scale, s + sbase)));
-        self.tubes
-            .extend(other.tubes.iter().map(|&(v, r, s)| (v.map(|i| i + base), r * scale, s + sbase)));
+        self.spheres
+            .extend(other.spheres.iter().map(|&(v, r, s)| (v + base, r * scale, s + sbase)));
+        self.tubes.extend(
+            other.tubes.iter().map(|&(v, r, s)| (v.map(|i| i + base), r * scale, s + sbase)),
+        );
         self.shadings.extend_from_slice(&other.shadings);
     }
 
@@ -304,6 +311,13 @@ pub struct Counters {
     /// geometry: lists that load matrices, draw points or lines, or are
     /// called inside `glBegin`).
     pub list_inline: u64,
+    /// Array draws from buffer objects recorded into a new cache entry.
+    pub draw_builds: u64,
+    /// Array draws from buffer objects answered from the cache.
+    pub draw_reuses: u64,
+    /// Array draws from client memory (or with points and lines),
+    /// recorded as immediate geometry.
+    pub draw_inline: u64,
     /// Instances in the last frame ended.
     pub instances: u64,
     /// Calls ignored because they break GL's rules (a vertex outside
@@ -326,6 +340,96 @@ struct List {
     cacheable: bool,
     /// Calls other lists: cached entries also depend on their definitions.
     nested: bool,
+    /// What the list sets before its first vertex (so does not inherit).
+    overrides: Overrides,
+}
+
+/// The inherited attributes a list sets before drawing anything: those
+/// are left out of its cache key, so the state the previous draw left
+/// behind (glxgears: the last gear's material and normal) does not make
+/// a new variant.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Overrides {
+    normal: bool,
+    color: bool,
+    ambient: bool,
+    diffuse: bool,
+    specular: bool,
+    emission: bool,
+    shininess: bool,
+    lit: bool,
+    flat: bool,
+}
+
+impl Overrides {
+    /// Scans `commands` up to the first vertex or nested call.
+    fn of(commands: &[Command]) -> Self {
+        let mut o = Self::default();
+        for c in commands {
+            match *c {
+                Command::Vertex(_) | Command::CallList(_) => break,
+                Command::Normal(_) => o.normal = true,
+                Command::Color(_) => o.color = true,
+                Command::Material(gl::FRONT | gl::FRONT_AND_BACK, pname, _) => match pname {
+                    gl::AMBIENT => o.ambient = true,
+                    gl::DIFFUSE => o.diffuse = true,
+                    gl::SPECULAR => o.specular = true,
+                    gl::EMISSION => o.emission = true,
+                    gl::SHININESS => o.shininess = true,
+                    gl::AMBIENT_AND_DIFFUSE => {
+                        o.ambient = true;
+                        o.diffuse = true;
+                    }
+                    _ => {}
+                },
+                Command::Enable(gl::LIGHTING) | Command::Disable(gl::LIGHTING) => o.lit = true,
+                Command::ShadeModel(_) => o.flat = true,
+                // Colour material ties colour and material together: keep
+                // everything in the key.
+                Command::Enable(gl::COLOR_MATERIAL) | Command::ColorMaterial(..) => {
+                    return Self::default();
+                }
+                _ => {}
+            }
+        }
+        o
+    }
+
+    /// `key` with what the list overrides replaced by a constant.
+    fn mask(self, mut key: Inherited) -> Inherited {
+        let m = &mut key.shading.material;
+        let zero = Vec4::ZERO;
+        if self.normal {
+            key.normal = Vec3::ZERO;
+        }
+        // Lit without colour material, the colour is never seen.
+        let unseen = !self.lit && key.shading.lit && key.shading.color_material.is_none();
+        if (self.color || unseen) && key.shading.color_material.is_none() {
+            key.color = zero;
+        }
+        if self.ambient {
+            m.ambient = zero;
+        }
+        if self.diffuse {
+            m.diffuse = zero;
+        }
+        if self.specular {
+            m.specular = zero;
+        }
+        if self.emission {
+            m.emission = zero;
+        }
+        if self.shininess {
+            m.shininess = 0.0;
+        }
+        if self.lit {
+            key.shading.lit = false;
+        }
+        if self.flat {
+            key.shading.flat = false;
+        }
+        key
+    }
 }
 
 /// The inherited state a cached list's geometry depends on.
@@ -345,6 +449,10 @@ struct Capture {
     /// Eye-space normals to entry space.
     normal_to_local: Mat3,
 }
+
+/// A vertex between `glBegin` and `glEnd`: eye-space position, normal and
+/// colour.
+type Vert = (Vec3, Vec3, Vec4);
 
 /// The fixed-function state machine; see the module documentation.
 pub struct Recorder {
@@ -372,13 +480,16 @@ pub struct Recorder {
     /// Bumped whenever a list is defined or deleted.
     generation: u64,
     compiling: Option<(u32, u32, Vec<Command>)>,
-    begin: Option<(u32, Vec<(Vec3, Vec3, Vec4)>)>,
+    begin: Option<(u32, Vec<Vert>)>,
     capture: Option<Capture>,
     /// > 0 while replaying a cached list for its state changes only.
     state_only: u32,
     depth: u32,
     cache: HashMap<u32, Vec<(Inherited, Arc<Geometry>)>>,
     frame: Frame,
+    /// Vertex arrays and buffer objects.
+    arrays: ArrayState,
+    draw_cache: HashMap<DrawKey, (Inherited, Arc<Geometry>)>,
     /// What has been done so far.
     pub counters: Counters,
 }
@@ -420,6 +531,8 @@ impl Recorder {
             depth: 0,
             cache: HashMap::new(),
             frame: Frame::default(),
+            arrays: ArrayState::default(),
+            draw_cache: HashMap::new(),
             counters: Counters::default(),
         }
     }
@@ -465,7 +578,9 @@ impl Recorder {
 
     /// `glNewList(id, mode)`.
     pub fn new_list(&mut self, id: u32, mode: u32) {
-        if id == 0 || self.compiling.is_some() || !matches!(mode, gl::COMPILE | gl::COMPILE_AND_EXECUTE)
+        if id == 0
+            || self.compiling.is_some()
+            || !matches!(mode, gl::COMPILE | gl::COMPILE_AND_EXECUTE)
         {
             self.counters.ignored += 1;
             return;
@@ -489,9 +604,10 @@ impl Recorder {
             )
         });
         let nested = commands.iter().any(|c| matches!(c, Command::CallList(_)));
+        let overrides = Overrides::of(&commands);
         self.generation += 1;
         self.cache.remove(&id);
-        self.lists.insert(id, List { commands: commands.into(), cacheable, nested });
+        self.lists.insert(id, List { commands: commands.into(), cacheable, nested, overrides });
     }
 
     /// `glListBase(base)`.
@@ -590,8 +706,7 @@ impl Recorder {
             Command::LoadIdentity => *self.top() = Mat4::IDENTITY,
             Command::LoadMatrix(m) => *self.top() = m,
             Command::MultMatrix(m) => {
-                let t = self.top();
-                *t = *t * m;
+                *self.top() *= m;
             }
             Command::PushMatrix => {
                 let s = self.stack();
@@ -711,7 +826,7 @@ impl Recorder {
     }
 
     /// Turns one `glBegin`/`glEnd` into triangles, spheres or tubes.
-    fn assemble(&mut self, mode: u32, verts: &[(Vec3, Vec3, Vec4)]) {
+    fn assemble(&mut self, mode: u32, verts: &[Vert]) {
         let shading = self.shading();
         let point_r = self.point_size * 0.5;
         let line_r = self.line_width * 0.5;
@@ -747,15 +862,17 @@ impl Recorder {
                 if i % 2 == 0 { tri(i, i + 1, i + 2, i + 2) } else { tri(i + 1, i, i + 2, i + 2) }
             }),
             gl::TRIANGLE_FAN => (1..n.saturating_sub(1)).for_each(|i| tri(0, i, i + 1, i + 1)),
+            // Quads split along the diagonal from their second vertex to
+            // their last, as Mesa does (it decides how colours interpolate).
             gl::QUADS => (0..n / 4).for_each(|q| {
                 let a = 4 * q;
-                tri(a, a + 1, a + 2, a + 3);
-                tri(a, a + 2, a + 3, a + 3);
+                tri(a, a + 1, a + 3, a + 3);
+                tri(a + 1, a + 2, a + 3, a + 3);
             }),
             gl::QUAD_STRIP => (0..n.saturating_sub(2) / 2).for_each(|q| {
                 let a = 2 * q;
-                tri(a, a + 1, a + 3, a + 3);
-                tri(a, a + 3, a + 2, a + 3);
+                tri(a, a + 1, a + 2, a + 3);
+                tri(a + 1, a + 3, a + 2, a + 3);
             }),
             gl::POLYGON => (1..n.saturating_sub(1)).for_each(|i| tri(0, i, i + 1, 0)),
             gl::POINTS => (0..n).for_each(|i| g.spheres.push((v(i), radius[i as usize], s))),
@@ -786,15 +903,13 @@ impl Recorder {
         self.depth += 1;
         let mv = self.modelview();
         let plain = self.state_only == 0 && self.capture.is_none() && self.begin.is_none();
-        let to_local = (mv.determinant() != 0.0).then(|| mv.inverse()).filter(|m| m.is_finite());
-        match to_local {
+        match Self::to_local(&mv) {
             Some(to_local) if plain && list.cacheable => {
-                let key = Inherited {
-                    color: self.color,
-                    normal: self.normal,
-                    shading: self.shading(),
-                    generation: if list.nested { self.generation } else { 0 },
-                };
+                let key = list.overrides.mask(self.inherited(if list.nested {
+                    self.generation
+                } else {
+                    0
+                }));
                 let hit = self.cache.get(&id).and_then(|v| v.iter().find(|(k, _)| *k == key));
                 let geometry = if let Some((_, g)) = hit {
                     let g = Arc::clone(g);
@@ -805,13 +920,7 @@ impl Recorder {
                     self.state_only -= 1;
                     g
                 } else {
-                    self.capture = Some(Capture {
-                        geometry: Geometry::default(),
-                        to_local,
-                        normal_to_local: Mat3::from_mat4(mv).transpose(),
-                    });
-                    self.run(&list.commands);
-                    let g = Arc::new(self.capture.take().map(|c| c.geometry).unwrap_or_default());
+                    let g = self.captured(mv, to_local, |r| r.run(&list.commands));
                     let variants = self.cache.entry(id).or_default();
                     if variants.len() >= VARIANTS_PER_LIST {
                         variants.remove(0);
@@ -820,9 +929,7 @@ impl Recorder {
                     self.counters.list_builds += 1;
                     g
                 };
-                if !geometry.is_empty() && self.state_only == 0 {
-                    self.frame.instances.push((geometry, mv));
-                }
+                self.instance(geometry, mv);
             }
             _ => {
                 if plain {
@@ -832,6 +939,36 @@ impl Recorder {
             }
         }
         self.depth -= 1;
+    }
+
+    /// The state a cached draw inherits; `generation`: the list
+    /// definitions it depends on (0: none).
+    fn inherited(&self, generation: u64) -> Inherited {
+        Inherited { color: self.color, normal: self.normal, shading: self.shading(), generation }
+    }
+
+    /// Runs `f` with its geometry recorded in the entry space of the
+    /// modelview `mv` (`to_local` its inverse).
+    fn captured(&mut self, mv: Mat4, to_local: Mat4, f: impl FnOnce(&mut Self)) -> Arc<Geometry> {
+        self.capture = Some(Capture {
+            geometry: Geometry::default(),
+            to_local,
+            normal_to_local: Mat3::from_mat4(mv).transpose(),
+        });
+        f(self);
+        Arc::new(self.capture.take().map(|c| c.geometry).unwrap_or_default())
+    }
+
+    /// Adds an instance of cached geometry to the frame.
+    fn instance(&mut self, geometry: Arc<Geometry>, mv: Mat4) {
+        if !geometry.is_empty() && self.state_only == 0 {
+            self.frame.instances.push((geometry, mv));
+        }
+    }
+
+    /// The modelview's inverse, if it has a finite one.
+    fn to_local(mv: &Mat4) -> Option<Mat4> {
+        (mv.determinant() != 0.0).then(|| mv.inverse()).filter(|m| m.is_finite())
     }
 
     fn run(&mut self, commands: &[Command]) {
