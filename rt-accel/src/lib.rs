@@ -19,7 +19,7 @@
 //! | feature | default | what it does |
 //! |---|---|---|
 //! | `std` | yes | std float functions; implies `alloc` |
-//! | `alloc` | via `std` | owned [`Bvh`], [`Scene`], [`TriangleMesh`], [`AlignedBytes`], copying loader, refit |
+//! | `alloc` | via `std` | owned [`Bvh`], [`Scene`], [`Instances`], [`TriangleMesh`], [`AlignedBytes`], copying loader, refit |
 //! | `obvhs` | yes | building ([`build_triangles`], [`build_spheres`], [`build_capsules`]); needs std |
 //! | `libm` | no | float functions from `libm` for `no_std` |
 //!
@@ -58,6 +58,8 @@ mod bytes;
 #[cfg(feature = "alloc")]
 mod check;
 mod error;
+#[cfg(feature = "alloc")]
+mod instance;
 mod isa;
 #[cfg(feature = "alloc")]
 mod mesh;
@@ -81,6 +83,8 @@ pub use build::{BuildParams, BuildQuality, build_capsules, build_spheres, build_
 pub use bvh::Bvh;
 pub use bytes::{Header, MAGIC, VERSION, validate};
 pub use error::{BuildError, LoadError};
+#[cfg(feature = "alloc")]
+pub use instance::{InstanceError, Instances, Object};
 pub use isa::{Isa, UnsupportedIsa};
 #[cfg(feature = "alloc")]
 pub use mesh::TriangleMesh;

@@ -11,17 +11,16 @@
 //! own image (the `gl` mode) needs exactly GL's equation; rt-accel's BVH
 //! answers the rays.
 
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use std::sync::Arc;
+
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
-use rt_accel::{BuildError, BuildParams, Scene, build_capsules, build_spheres, build_triangles};
+use rt_accel::{BuildError, InstanceError, Instances, Object, Scene};
 use rt_core::{
-    Hit, PrimKind, Ray, SceneQuery,
-    camera::cosine_hemisphere,
-    intersect::{Capsule, Sphere},
-    sampling, spawn_ray, spawn_ray_to,
+    Hit, PrimKind, Ray, SceneQuery, camera::cosine_hemisphere, sampling, spawn_ray, spawn_ray_to,
 };
 
-use crate::record::{Frame, Geometry, Lighting, Shading};
+use crate::record::{Frame, Geometry, Lighting, Recorded, Shading, normal_matrix};
 
 /// How frames are shaded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -106,6 +105,8 @@ pub enum RenderError {
     BadProjection,
     /// The viewport is empty or larger than 16384 × 16384.
     BadViewport,
+    /// A recorded modelview cannot place an instance.
+    Instance(InstanceError),
 }
 
 impl core::fmt::Display for RenderError {
@@ -114,6 +115,7 @@ impl core::fmt::Display for RenderError {
             Self::Build(e) => write!(f, "building the frame's BVH: {e}"),
             Self::BadProjection => write!(f, "projection matrix is singular or not finite"),
             Self::BadViewport => write!(f, "viewport empty or larger than 16384 × 16384"),
+            Self::Instance(e) => write!(f, "placing a recorded list: {e}"),
         }
     }
 }
@@ -126,50 +128,66 @@ impl From<BuildError> for RenderError {
     }
 }
 
-/// A frame's geometry in eye space behind BVHs.
+/// A frame behind BVHs: the immediate geometry (eye space, built per
+/// frame) and a two-level hierarchy of the recorded lists and buffer
+/// draws (each recording's BVHs built once, kept across frames).
 pub struct FrameScene {
-    geometry: Geometry,
+    immediate: Geometry,
     scene: Scene,
+    instances: Instances<Arc<Recorded>>,
+    /// Per instance: the normal matrix of its transform.
+    normal: Vec<Mat3>,
     diagonal: f32,
 }
 
+/// Which geometry a hit belongs to.
+#[derive(Clone, Copy, Debug)]
+enum Source {
+    Immediate,
+    Instance(u32),
+}
+
 impl FrameScene {
-    /// Builds the BVHs over everything `frame` drew.
+    /// Builds the immediate geometry's BVHs and the top level over the
+    /// frame's instances (building any recording's BVHs not built yet).
     ///
     /// # Errors
-    /// [`RenderError::Build`] if a primitive is not finite.
+    /// [`RenderError::Build`] if a primitive is not finite;
+    /// [`RenderError::Instance`] if a transform is singular.
     pub fn build(frame: &Frame) -> Result<Self, RenderError> {
-        let geometry = frame.flatten();
-        let params = BuildParams::fast();
-        let g = &geometry;
-        let spheres: Vec<Sphere> =
-            g.spheres.iter().map(|&(v, r, _)| Sphere::new(g.positions[v as usize], r)).collect();
-        let tubes: Vec<Capsule> = g
-            .tubes
-            .iter()
-            .map(|&([a, b], r, _)| {
-                Capsule::new(g.positions[a as usize], g.positions[b as usize], r)
-            })
-            .collect();
-        let scene = Scene {
-            triangles: build_triangles(&g.positions, &g.triangles, &params)?,
-            spheres: build_spheres(&spheres, &params)?,
-            capsules: build_capsules(&tubes, &params)?,
-        };
-        let b = scene
-            .triangles
-            .as_ref()
-            .bounds()
-            .union(scene.spheres.as_ref().bounds())
-            .union(scene.capsules.as_ref().bounds());
+        let scene = frame.immediate.build()?;
+        let mut objects: Vec<Arc<Recorded>> = Vec::new();
+        let mut placements = Vec::with_capacity(frame.instances.len());
+        for (rec, m) in &frame.instances {
+            let k = match objects.iter().position(|o| Arc::ptr_eq(o, rec)) {
+                Some(k) => k,
+                None => {
+                    rec.scene()?;
+                    objects.push(Arc::clone(rec));
+                    objects.len() - 1
+                }
+            };
+            placements.push((k as u32, *m));
+        }
+        let normal = placements.iter().map(|(_, m)| normal_matrix(m)).collect();
+        let instances = Instances::new(objects, &placements).map_err(RenderError::Instance)?;
+        let b = Object::bounds(&scene).union(instances.bounds());
         let diagonal = if b.is_empty() { 0.0 } else { (b.max - b.min).length() };
-        Ok(Self { geometry, scene, diagonal })
+        Ok(Self { immediate: frame.immediate.clone(), scene, instances, normal, diagonal })
     }
 
-    /// The geometry the BVHs hold.
-    #[must_use]
-    pub fn geometry(&self) -> &Geometry {
-        &self.geometry
+    /// The closest hit among the immediate geometry and the instances.
+    fn closest(&self, ray: &Ray) -> Option<(Source, Hit)> {
+        let a = SceneQuery::closest_hit(&self.scene, ray);
+        let r = Ray { t_max: a.map_or(ray.t_max, |h| h.t), ..*ray };
+        match self.instances.closest_hit_instance(&r) {
+            Some((i, h)) if a.is_none_or(|a| h.t < a.t) => Some((Source::Instance(i), h)),
+            _ => a.map(|h| (Source::Immediate, h)),
+        }
+    }
+
+    fn occluded(&self, ray: &Ray) -> bool {
+        SceneQuery::occluded(&self.scene, ray) || self.instances.occluded(ray)
     }
 
     /// Ray traces the frame at `width × height` through `projection`,
@@ -205,10 +223,10 @@ impl FrameScene {
                 let far = inv.project_point3(ndc.extend(1.0));
                 // Parameter 0..1 spans the near to the far plane: GL's clipping.
                 let ray = Ray::with_range(near, far - near, 0.0, 1.0);
-                let c = match self.scene.closest_hit(&ray) {
-                    Some(hit) => {
+                let c = match self.closest(&ray) {
+                    Some((src, hit)) => {
                         let seed = (y as u64) << 32 | x as u64;
-                        to_rgba8(self.shade(&ray, &hit, lighting, opts, seed))
+                        to_rgba8(self.shade(&ray, src, &hit, lighting, opts, seed))
                     }
                     None => bg,
                 };
@@ -218,9 +236,23 @@ impl FrameScene {
         Ok(Image { width, height, rgba })
     }
 
-    /// The shading, colour and normal at a hit.
-    fn surface(&self, hit: &Hit) -> (Shading, Vec4, Vec3) {
-        let g = &self.geometry;
+    /// The shading, colour and normal (eye space) at a hit.
+    fn surface(&self, src: Source, hit: &Hit) -> (Shading, Vec4, Vec3) {
+        let (g, nm) = match src {
+            Source::Immediate => (&self.immediate, Mat3::IDENTITY),
+            Source::Instance(i) => {
+                // `i` came from this frame's own instances.
+                let obj = self.instances.object_of(i).unwrap_or(0);
+                (&self.instances.objects()[obj as usize].geometry, self.normal[i as usize])
+            }
+        };
+        let (sh, col, n) = Self::surface_in(g, hit);
+        // Spheres and tubes already give the world normal.
+        let n = if hit.kind == PrimKind::Triangle { nm * n } else { n };
+        (sh, col, n)
+    }
+
+    fn surface_in(g: &Geometry, hit: &Hit) -> (Shading, Vec4, Vec3) {
         let p = hit.prim as usize;
         match hit.kind {
             PrimKind::Triangle => {
@@ -256,8 +288,16 @@ impl FrameScene {
     }
 
     /// GL's lighting equation at `hit`, per pixel.
-    fn shade(&self, ray: &Ray, hit: &Hit, lighting: &Lighting, opts: &Options, seed: u64) -> Vec4 {
-        let (sh, color, normal) = self.surface(hit);
+    fn shade(
+        &self,
+        ray: &Ray,
+        src: Source,
+        hit: &Hit,
+        lighting: &Lighting,
+        opts: &Options,
+        seed: u64,
+    ) -> Vec4 {
+        let (sh, color, normal) = self.surface(src, hit);
         if !sh.lit {
             return color;
         }
@@ -319,7 +359,7 @@ impl FrameScene {
                     None => spawn_ray(p, hit.position_error, geo_n, to_light),
                     Some(lp) => spawn_ray_to(p, hit.position_error, geo_n, lp),
                 };
-                if self.scene.occluded(&shadow) {
+                if self.occluded(&shadow) {
                     continue;
                 }
             }
@@ -343,7 +383,7 @@ impl FrameScene {
             let l = cosine_hemisphere(sampling::uniform2(&mut rng));
             let mut r = spawn_ray(hit.position, hit.position_error, n, t * l.x + b * l.y + n * l.z);
             r.t_max = reach;
-            if !self.scene.occluded(&r) {
+            if !self.occluded(&r) {
                 open += 1;
             }
         }

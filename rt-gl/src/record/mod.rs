@@ -16,9 +16,19 @@
 //! The recorder is plain Rust, with no GL in it: the interposer feeds it
 //! the calls it forwards, and the tests feed it directly.
 
-use std::{collections::HashMap, sync::Arc};
+use std::{
+    collections::HashMap,
+    sync::{Arc, OnceLock},
+};
 
 use glam::{Mat3, Mat4, Vec3, Vec4};
+use rt_accel::{
+    BuildError, BuildParams, Object, Scene, build_capsules, build_spheres, build_triangles,
+};
+use rt_core::{
+    Aabb, Hit, Ray, SceneQuery,
+    intersect::{Capsule, Sphere},
+};
 
 use crate::gl;
 
@@ -254,6 +264,31 @@ impl Geometry {
         self.shadings.extend_from_slice(&other.shadings);
     }
 
+    /// BVHs over the triangles, spheres and tubes.
+    ///
+    /// # Errors
+    /// [`BuildError`] if a primitive is not finite.
+    pub fn build(&self) -> Result<Scene, BuildError> {
+        let params = BuildParams::fast();
+        let spheres: Vec<Sphere> = self
+            .spheres
+            .iter()
+            .map(|&(v, r, _)| Sphere::new(self.positions[v as usize], r))
+            .collect();
+        let tubes: Vec<Capsule> = self
+            .tubes
+            .iter()
+            .map(|&([a, b], r, _)| {
+                Capsule::new(self.positions[a as usize], self.positions[b as usize], r)
+            })
+            .collect();
+        Ok(Scene {
+            triangles: build_triangles(&self.positions, &self.triangles, &params)?,
+            spheres: build_spheres(&spheres, &params)?,
+            capsules: build_capsules(&tubes, &params)?,
+        })
+    }
+
     fn shading_index(&mut self, s: Shading) -> u32 {
         if self.shadings.last() != Some(&s) {
             self.shadings.push(s);
@@ -270,6 +305,50 @@ pub fn normal_matrix(m: &Mat4) -> Mat3 {
     if a.determinant() == 0.0 { Mat3::IDENTITY } else { a.inverse().transpose() }
 }
 
+/// Geometry recorded once (a display list or a buffer draw) and its
+/// BVHs, built the first time a frame is traced and kept while the
+/// recording is.
+#[derive(Debug)]
+pub struct Recorded {
+    /// The geometry, in its entry space.
+    pub geometry: Geometry,
+    scene: OnceLock<Result<Scene, BuildError>>,
+}
+
+impl Recorded {
+    /// A recording whose BVHs are not built yet.
+    #[must_use]
+    pub fn new(geometry: Geometry) -> Self {
+        Self { geometry, scene: OnceLock::new() }
+    }
+
+    /// The BVHs over the geometry, built on first use.
+    ///
+    /// # Errors
+    /// The build's error (a primitive that is not finite).
+    pub fn scene(&self) -> Result<&Scene, BuildError> {
+        self.scene.get_or_init(|| self.geometry.build()).as_ref().map_err(Clone::clone)
+    }
+
+    /// Whether the BVHs have been built.
+    #[must_use]
+    pub fn is_built(&self) -> bool {
+        self.scene.get().is_some()
+    }
+}
+
+impl Object for Recorded {
+    fn bounds(&self) -> Aabb {
+        self.scene().map_or(Aabb::EMPTY, Object::bounds)
+    }
+    fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        SceneQuery::closest_hit(self.scene().ok()?, ray)
+    }
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.scene().is_ok_and(|s| SceneQuery::occluded(s, ray))
+    }
+}
+
 /// One frame's draws: immediate geometry in eye space and instances of
 /// cached display lists.
 #[derive(Clone, Debug, Default)]
@@ -277,14 +356,14 @@ pub struct Frame {
     /// Immediate-mode geometry, eye space.
     pub immediate: Geometry,
     /// Cached list geometry and the modelview of each call.
-    pub instances: Vec<(Arc<Geometry>, Mat4)>,
+    pub instances: Vec<(Arc<Recorded>, Mat4)>,
 }
 
 impl Frame {
     /// Whether nothing was drawn.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.immediate.is_empty() && self.instances.iter().all(|(g, _)| g.is_empty())
+        self.immediate.is_empty() && self.instances.iter().all(|(r, _)| r.geometry.is_empty())
     }
 
     /// Everything in eye space, in one piece.
@@ -292,7 +371,7 @@ impl Frame {
     pub fn flatten(&self) -> Geometry {
         let mut g = self.immediate.clone();
         for (inst, m) in &self.instances {
-            g.append_transformed(inst, m);
+            g.append_transformed(&inst.geometry, m);
         }
         g
     }
@@ -485,11 +564,11 @@ pub struct Recorder {
     /// > 0 while replaying a cached list for its state changes only.
     state_only: u32,
     depth: u32,
-    cache: HashMap<u32, Vec<(Inherited, Arc<Geometry>)>>,
+    cache: HashMap<u32, Vec<(Inherited, Arc<Recorded>)>>,
     frame: Frame,
     /// Vertex arrays and buffer objects.
     arrays: ArrayState,
-    draw_cache: HashMap<DrawKey, (Inherited, Arc<Geometry>)>,
+    draw_cache: HashMap<DrawKey, (Inherited, Arc<Recorded>)>,
     /// What has been done so far.
     pub counters: Counters,
 }
@@ -949,19 +1028,19 @@ impl Recorder {
 
     /// Runs `f` with its geometry recorded in the entry space of the
     /// modelview `mv` (`to_local` its inverse).
-    fn captured(&mut self, mv: Mat4, to_local: Mat4, f: impl FnOnce(&mut Self)) -> Arc<Geometry> {
+    fn captured(&mut self, mv: Mat4, to_local: Mat4, f: impl FnOnce(&mut Self)) -> Arc<Recorded> {
         self.capture = Some(Capture {
             geometry: Geometry::default(),
             to_local,
             normal_to_local: Mat3::from_mat4(mv).transpose(),
         });
         f(self);
-        Arc::new(self.capture.take().map(|c| c.geometry).unwrap_or_default())
+        Arc::new(Recorded::new(self.capture.take().map(|c| c.geometry).unwrap_or_default()))
     }
 
     /// Adds an instance of cached geometry to the frame.
-    fn instance(&mut self, geometry: Arc<Geometry>, mv: Mat4) {
-        if !geometry.is_empty() && self.state_only == 0 {
+    fn instance(&mut self, geometry: Arc<Recorded>, mv: Mat4) {
+        if !geometry.geometry.is_empty() && self.state_only == 0 {
             self.frame.instances.push((geometry, mv));
         }
     }
