@@ -103,6 +103,9 @@ pub struct Plot {
     /// Drawn in order; they take [`PALETTE`]'s colours and the markers
     /// circle, square, triangle, diamond in turn.
     pub series: Vec<Series>,
+    /// Ring the Pareto front (for run time against error; off where the
+    /// axes mean something else, e.g. frame time against scene size).
+    pub pareto: bool,
 }
 
 /// The series' colours in order (Okabe & Ito 2008, readable with colour
@@ -197,17 +200,24 @@ pub fn loglog(plot: &Plot, width: u32, height: u32, path: &Path) -> Result<(), P
             )?;
         }
         // The Pareto front: points that no other point beats on both axes.
-        let front: Vec<(f64, f64)> = all
-            .iter()
-            .copied()
-            .filter(|&(px, py)| !all.iter().any(|&(a, b)| a <= px && b <= py && (a < px || b < py)))
-            .collect();
-        let ring = BLACK.stroke_width(2);
-        chart
-            .draw_series(front.iter().map(|&p| EmptyElement::at(p) + Circle::new((0, 0), 8, ring)))?
-            .label("Pareto front")
-            .legend(move |p| EmptyElement::at(p) + Circle::new((10, 0), 7, ring));
-        let names = plot.series.iter().map(|s| s.name.as_str()).chain(["Pareto front"]);
+        if plot.pareto {
+            let front: Vec<(f64, f64)> = all
+                .iter()
+                .copied()
+                .filter(|&(px, py)| {
+                    !all.iter().any(|&(a, b)| a <= px && b <= py && (a < px || b < py))
+                })
+                .collect();
+            let ring = BLACK.stroke_width(2);
+            chart
+                .draw_series(
+                    front.iter().map(|&p| EmptyElement::at(p) + Circle::new((0, 0), 8, ring)),
+                )?
+                .label("Pareto front")
+                .legend(move |p| EmptyElement::at(p) + Circle::new((10, 0), 7, ring));
+        }
+        let front_name = plot.pareto.then_some("Pareto front");
+        let names = plot.series.iter().map(|s| s.name.as_str()).chain(front_name);
         let corner = legend_corner(&x, &y, &series, names, chart.plotting_area().dim_in_pixel());
         chart
             .configure_series_labels()
@@ -411,6 +421,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("plot.png");
         let plot = Plot {
+            pareto: true,
             title: "test".into(),
             x_label: "seconds".into(),
             y_label: "error".into(),

@@ -35,7 +35,17 @@ impl Isa {
     /// features of the build).
     #[must_use]
     pub fn detect() -> Self {
-        Self::ALL.into_iter().rev().find(|isa| isa.is_available()).unwrap_or(Self::Portable)
+        // Every BVH query asks: remember the answer (0: not asked yet).
+        static DETECTED: core::sync::atomic::AtomicU8 = core::sync::atomic::AtomicU8::new(0);
+        let known = DETECTED.load(core::sync::atomic::Ordering::Relaxed);
+        if let Some(&isa) = known.checked_sub(1).and_then(|i| Self::ALL.get(usize::from(i))) {
+            return isa;
+        }
+        let isa =
+            Self::ALL.into_iter().rev().find(|isa| isa.is_available()).unwrap_or(Self::Portable);
+        let index = Self::ALL.iter().position(|&a| a == isa).unwrap_or(0) as u8;
+        DETECTED.store(index + 1, core::sync::atomic::Ordering::Relaxed);
+        isa
     }
 
     /// Whether this CPU (and this build's target) runs the kernel.

@@ -19,6 +19,8 @@
 //! may visit a node for one ray that another ray did not need; that costs
 //! time, never a different answer.
 
+use core::mem::MaybeUninit;
+
 use rt_core::{Ray, internal::widen_far};
 
 use crate::{
@@ -164,11 +166,13 @@ unsafe fn child_test_avx(
 }
 
 /// A packet traversal's stack: subtrees with the rays that still want them
-/// and the nearest of their entry distances.
+/// and the nearest of their entry distances. Entries `0..sp` are written;
+/// the others start uninitialized (a fresh stack costs nothing) and are
+/// never read.
 struct Stack {
-    refs: [ChildRef; STACK_SIZE],
-    rays: [u8; STACK_SIZE],
-    ts: [f32; STACK_SIZE],
+    refs: [MaybeUninit<ChildRef>; STACK_SIZE],
+    rays: [MaybeUninit<u8>; STACK_SIZE],
+    ts: [MaybeUninit<f32>; STACK_SIZE],
     sp: usize,
 }
 
@@ -176,19 +180,35 @@ impl Stack {
     #[inline(always)]
     fn new() -> Self {
         Self {
-            refs: [ChildRef::EMPTY; STACK_SIZE],
-            rays: [0; STACK_SIZE],
-            ts: [0.0; STACK_SIZE],
+            refs: [MaybeUninit::uninit(); STACK_SIZE],
+            rays: [MaybeUninit::uninit(); STACK_SIZE],
+            ts: [MaybeUninit::uninit(); STACK_SIZE],
             sp: 0,
         }
     }
 
     #[inline(always)]
     fn push(&mut self, c: ChildRef, rays: u32, t: f32) {
-        self.refs[self.sp] = c;
-        self.rays[self.sp] = rays as u8;
-        self.ts[self.sp] = t;
+        self.refs[self.sp].write(c);
+        self.rays[self.sp].write(rays as u8);
+        self.ts[self.sp].write(t);
         self.sp += 1;
+    }
+
+    /// Pops the top entry `(ref, rays, t)`; `None` when empty.
+    #[inline(always)]
+    fn pop(&mut self) -> Option<(ChildRef, u32, f32)> {
+        self.sp = self.sp.checked_sub(1)?;
+        let i = self.sp;
+        // SAFETY: `push` wrote all three arrays at every index below the
+        // count it keeps.
+        Some(unsafe {
+            (
+                self.refs[i].assume_init(),
+                u32::from(self.rays[i].assume_init()),
+                self.ts[i].assume_init(),
+            )
+        })
     }
 }
 
@@ -370,13 +390,10 @@ impl<P: Primitive> BvhRef<'_, P> {
             }
             // Pop the next subtree some ray may still find a closer hit in.
             loop {
-                if stack.sp == 0 {
+                let Some((r_top, mut bits, t)) = stack.pop() else {
                     break 'walk;
-                }
-                stack.sp -= 1;
-                let t = stack.ts[stack.sp];
+                };
                 let mut keep = 0;
-                let mut bits = u32::from(stack.rays[stack.sp]);
                 while bits != 0 {
                     let r = bits.trailing_zeros() as usize;
                     bits &= bits - 1;
@@ -385,7 +402,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                     }
                 }
                 if keep != 0 {
-                    cur = stack.refs[stack.sp];
+                    cur = r_top;
                     rays = keep;
                     continue 'walk;
                 }
@@ -447,13 +464,12 @@ impl<P: Primitive> BvhRef<'_, P> {
                 }
             }
             loop {
-                if stack.sp == 0 {
+                let Some((r_top, bits, _)) = stack.pop() else {
                     return done;
-                }
-                stack.sp -= 1;
-                let keep = u32::from(stack.rays[stack.sp]) & !done;
+                };
+                let keep = bits & !done;
                 if keep != 0 {
-                    cur = stack.refs[stack.sp];
+                    cur = r_top;
                     rays = keep;
                     break;
                 }

@@ -79,7 +79,7 @@ fn present_frame(buffer: u32) {
         }
         let c = counters;
         let line = format!(
-            "frames={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_inline={} instances={} ignored={}\n",
+            "frames={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_inline={} instances={} triangles={} ignored={}\n",
             c.frames,
             c.list_builds,
             c.list_reuses,
@@ -88,6 +88,7 @@ fn present_frame(buffer: u32) {
             c.draw_reuses,
             c.draw_inline,
             c.instances,
+            c.triangles,
             c.ignored
         );
         let _ = std::fs::write(dir.join("counters.txt"), line);

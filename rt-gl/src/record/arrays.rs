@@ -323,37 +323,35 @@ impl Recorder {
         }
     }
 
-    /// The draw as the commands immediate mode would have sent.
+    /// Sends the draw as immediate mode would have, one call at a time,
+    /// through [`Recorder::command`] (so an open display list stores it).
     ///
     /// # Safety
     /// As [`Self::element`] and [`Self::index_list`].
-    unsafe fn expand(&mut self, mode: u32, idx: Indices) -> Vec<Command> {
+    unsafe fn emit(&mut self, mode: u32, idx: Indices) {
         // SAFETY: passed on from the caller.
         let Some(indices) = (unsafe { self.index_list(idx) }) else {
             self.counters.ignored += 1;
-            return Vec::new();
+            return;
         };
         let a = &self.arrays;
         let (Some(vp), true) = (a.vertex, a.vertex_on) else {
-            return Vec::new();
+            return;
         };
         let np = a.normal.filter(|_| a.normal_on);
         let cp = a.color.filter(|_| a.color_on);
-        let mut out = Vec::with_capacity(
-            2 + indices.len() * (1 + usize::from(np.is_some()) + usize::from(cp.is_some())),
-        );
-        out.push(Command::Begin(mode));
+        self.command(Command::Begin(mode));
         let mut missing = false;
         for i in indices {
             // SAFETY (all three): passed on from the caller.
             if let Some(c) = cp.and_then(|p| unsafe { self.fetch(&p, i, true) }) {
-                out.push(Command::Color(c));
+                self.command(Command::Color(c));
             }
             if let Some(n) = np.and_then(|p| unsafe { self.fetch(&p, i, true) }) {
-                out.push(Command::Normal(Vec3::new(n.x, n.y, n.z)));
+                self.command(Command::Normal(Vec3::new(n.x, n.y, n.z)));
             }
             match unsafe { self.fetch(&vp, i, false) } {
-                Some(v) => out.push(Command::Vertex(v)),
+                Some(v) => self.command(Command::Vertex(v)),
                 None => missing = true,
             }
         }
@@ -361,8 +359,7 @@ impl Recorder {
             // An index past a buffer's end: GL's behaviour is undefined.
             self.counters.ignored += 1;
         }
-        out.push(Command::End);
-        out
+        self.command(Command::End);
     }
 
     /// `glDrawArrays(mode, first, count)`.
@@ -422,7 +419,7 @@ impl Recorder {
     }
 
     /// # Safety
-    /// As [`Self::expand`].
+    /// As [`Self::emit`].
     unsafe fn draw(&mut self, mode: u32, idx: Indices) {
         let points_or_lines =
             matches!(mode, gl::POINTS | gl::LINES | gl::LINE_LOOP | gl::LINE_STRIP);
@@ -451,8 +448,7 @@ impl Recorder {
                 return;
             }
             // SAFETY: passed on from the caller.
-            let commands = unsafe { self.expand(mode, idx) };
-            let g = self.captured(mv, to_local, |r| r.run(&commands));
+            let g = self.captured(mv, to_local, |r| unsafe { r.emit(mode, idx) });
             if self.draw_cache.len() >= MAX_CACHED_DRAWS {
                 self.draw_cache.clear();
             }
@@ -460,16 +456,13 @@ impl Recorder {
             self.counters.draw_builds += 1;
             self.instance(g, mv);
         } else {
-            // SAFETY: passed on from the caller.
-            let commands = unsafe { self.expand(mode, idx) };
             if self.compiling.is_none() {
                 self.counters.draw_inline += 1;
             }
             // In a display list the arrays are read now and the list
             // stores the vertices, as GL does.
-            for c in commands {
-                self.command(c);
-            }
+            // SAFETY: passed on from the caller.
+            unsafe { self.emit(mode, idx) };
         }
     }
 }

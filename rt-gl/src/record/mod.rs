@@ -399,6 +399,8 @@ pub struct Counters {
     pub draw_inline: u64,
     /// Instances in the last frame ended.
     pub instances: u64,
+    /// Triangles in the last frame ended (immediate and instanced).
+    pub triangles: u64,
     /// Calls ignored because they break GL's rules (a vertex outside
     /// `glBegin`, an unknown primitive type, a stack over- or underflow, …).
     pub ignored: u64,
@@ -645,6 +647,9 @@ impl Recorder {
     pub fn end_frame(&mut self) -> Frame {
         self.counters.frames += 1;
         self.counters.instances = self.frame.instances.len() as u64;
+        self.counters.triangles = (self.frame.immediate.triangles.len()
+            + self.frame.instances.iter().map(|(r, _)| r.geometry.triangles.len()).sum::<usize>())
+            as u64;
         core::mem::take(&mut self.frame)
     }
 

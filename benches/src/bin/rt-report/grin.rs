@@ -192,6 +192,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         }
         let png = dir.join(format!("grin-{case}.png"));
         let plot = Plot {
+            pareto: true,
             title: format!(
                 "GRIN integrators, {case} field: error against time (step / tolerance sweep)"
             ),

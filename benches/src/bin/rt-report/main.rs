@@ -9,6 +9,7 @@
 //! cargo run --release -p rt-benches --bin rt-report -- noise [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- render [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- composite [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- gl [--quick]         # needs xvfb-run, cc, glxgears
 //! cargo run --release -p rt-benches --bin rt-report -- all [--quick]   # + index.md
 //! ```
 // A std-only tool crate: the no_std import lints guard the libraries.
@@ -17,6 +18,7 @@
 mod composite;
 #[cfg(feature = "embree3")]
 mod embree3;
+mod gl;
 mod grin;
 mod noise;
 mod octree;
@@ -123,8 +125,9 @@ fn main() -> ExitCode {
             "noise" => noise::run(&dir, quick),
             "render" => render::run(&dir, quick),
             "composite" => composite::run(&dir, quick),
+            "gl" => gl::run(&dir, quick),
             other => Err(format!(
-                "unknown area `{other}` (known: traversal, grin, octree, schlieren, noise, render, composite, all)"
+                "unknown area `{other}` (known: traversal, grin, octree, schlieren, noise, render, composite, gl, all)"
             )),
         };
         match result {

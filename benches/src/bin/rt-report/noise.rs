@@ -150,6 +150,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         .unwrap_or_default();
     loglog(
         &Plot {
+            pareto: true,
             title: "Schlieren image noise against photons per pixel (blast wave, two seeds)".into(),
             x_label: "photons per pixel".into(),
             y_label: "rms noise in disturbed pixels / background".into(),

@@ -98,6 +98,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     }
     std::fs::write(dir.join("octree.csv"), &csv).map_err(|e| e.to_string())?;
     let plot = Plot {
+        pareto: true,
         title: "Octree skipping: error against time over tolerances 1e-3 … 1e-7".into(),
         x_label: format!("seconds for {} rays (best of 3)", rays.len()),
         y_label: "max deflection error |Δ direction| (1e-17 = exact)".into(),

@@ -223,6 +223,7 @@ fn ao_error(dir: &Path, scene: &SurfaceScene<'_>, quick: bool) -> Result<String,
     std::fs::write(dir.join("render-ao.csv"), &csv).map_err(|e| e.to_string())?;
     let png = dir.join("render.png");
     let plot = Plot {
+        pareto: true,
         title: format!("Ambient occlusion noise against time ({size}², 1–16 AO rays per pixel)"),
         x_label: "seconds per frame (one pass, all cores, best of 3)".into(),
         y_label: "rmse against the 256-ray reference (linear RGB)".into(),

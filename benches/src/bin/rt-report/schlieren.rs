@@ -86,6 +86,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     .collect();
     let png = dir.join("schlieren.png");
     let plot = Plot {
+        pareto: true,
         title: format!(
             "Schlieren, {FILM}² film: error against time over {} … {} photons per pixel",
             strata[0].pow(2),
