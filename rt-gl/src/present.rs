@@ -54,29 +54,7 @@ fn present_frame(buffer: u32) {
             log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
         }
     }
-    let rendered = crate::catch(|| {
-        let scene = FrameScene::build(&frame)?;
-        let render =
-            || scene.render(&lighting, projection, w as u32, h as u32, background, &cfg.options);
-        match &cfg.pool {
-            Some(pool) => pool.install(render),
-            None => render(),
-        }
-    });
-    let img = match rendered {
-        Some(Ok(img)) => img,
-        Some(Err(e)) => {
-            log_once("render", &format!("frame {n} left as rasterized: {e}"));
-            return;
-        }
-        None => return,
-    };
-    // SAFETY: `img` holds w·h RGBA pixels; the state touched is restored.
-    unsafe { draw(&img, x, y, buffer) };
     if let Some(dir) = &cfg.dump {
-        if let Err(e) = img.write_png(&dir.join(format!("rt-{n:04}.png"))) {
-            log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
-        }
         let c = counters;
         let line = format!(
             "frames={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_inline={} instances={} triangles={} ignored={}\n",
@@ -92,6 +70,31 @@ fn present_frame(buffer: u32) {
             c.ignored
         );
         let _ = std::fs::write(dir.join("counters.txt"), line);
+    }
+    let rendered = crate::catch(|| {
+        let scene = FrameScene::build(&frame)?;
+        let render =
+            || scene.render(&lighting, projection, w as u32, h as u32, background, &cfg.options);
+        match &cfg.pool {
+            Some(pool) => pool.install(render),
+            None => render(),
+        }
+    });
+    let img = match rendered {
+        Some(Ok(img)) => img,
+        Some(Err(e)) => {
+            // Once per cause.
+            log_once(&format!("render: {e}"), &format!("frame {n} left as rasterized: {e}"));
+            return;
+        }
+        None => return,
+    };
+    // SAFETY: `img` holds w·h RGBA pixels; the state touched is restored.
+    unsafe { draw(&img, x, y, buffer) };
+    if let Some((dir, Err(e))) =
+        cfg.dump.as_ref().map(|d| (d, img.write_png(&d.join(format!("rt-{n:04}.png")))))
+    {
+        log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
     }
     if cfg.stats {
         eprintln!("rt-gl: frame {n}: {:?}", counters);

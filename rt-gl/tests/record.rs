@@ -363,3 +363,31 @@ fn bad_views_and_vertices_are_refused() {
     r.delete_lists(1, -1);
     assert_eq!(r.counters.ignored, 4);
 }
+
+/// Settings from the environment: good values are taken, unreadable ones
+/// fall back to the defaults (reported once on stderr, not fatal).
+#[test]
+fn settings_fall_back_on_unreadable_values() {
+    let cfg = |pairs: &'static [(&'static str, &'static str)]| {
+        rt_gl::Config::from_vars(move |k| {
+            pairs.iter().find(|(n, _)| *n == k).map(|(_, v)| (*v).to_owned())
+        })
+    };
+    let good = cfg(&[
+        ("RT_GL_MODE", "rt"),
+        ("RT_GL_AO", "32"),
+        ("RT_GL_SHADOWS", "0"),
+        ("RT_GL_THREADS", "2"),
+    ]);
+    assert_eq!(good.options.mode, Mode::Rt);
+    assert_eq!((good.options.ao_samples, good.options.shadows), (32, false));
+    assert_eq!(good.pool.as_ref().map(rayon::ThreadPool::current_num_threads), Some(2));
+    let bad = cfg(&[
+        ("RT_GL_MODE", "fancy"),
+        ("RT_GL_AO", "-3"),
+        ("RT_GL_SHADOWS", "maybe"),
+        ("RT_GL_THREADS", "0"),
+    ]);
+    assert_eq!(bad.options, Options::default());
+    assert!(bad.pool.is_none() && bad.dump.is_none() && !bad.stats);
+}

@@ -24,7 +24,7 @@
 
 /* The window: 256² for the scenes, 512² for the mesh timing. */
 static int W = 256, H = 256;
-#define SCENES 9
+#define SCENES 10
 
 static double now(void) {
     struct timespec t;
@@ -379,6 +379,20 @@ static void scene(int s, int frame) {
         glPopMatrix(); glPopMatrix();    /* underflow */
         glCallList(999999);              /* no such list */
         while (glGetError() != GL_NO_ERROR) {}
+        break;
+    case 9: /* a frame rt-gl cannot trace (a singular projection): it must
+               keep what GL drew (here nothing) and carry on */
+        {
+            static const GLfloat zero[16] = {0};
+            glMatrixMode(GL_PROJECTION);
+            glLoadMatrixf(zero);
+            glMatrixMode(GL_MODELVIEW);
+            glLoadIdentity();
+            glColor3f(1, 1, 1);
+            glBegin(GL_TRIANGLES);
+            glVertex2f(0, 0); glVertex2f(1, 0); glVertex2f(0, 1);
+            glEnd();
+        }
         break;
     }
 }
