@@ -12,13 +12,30 @@ use std::{
     process::Command,
 };
 
-/// The cdylib cargo built beside this test binary.
+/// The interposer (the cdylib) of this test's profile, built first: `cargo
+/// test` builds only the rlib the tests link.
 fn interposer() -> PathBuf {
-    let exe = std::env::current_exe().expect("test binary path");
-    let dir = exe.parent().and_then(Path::parent).expect("target directory");
-    let lib = dir.join("librt_gl.so");
-    assert!(lib.exists(), "{} not built", lib.display());
-    lib
+    static BUILT: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    BUILT
+        .get_or_init(|| {
+            let exe = std::env::current_exe().expect("test binary path");
+            // <target>/<profile>/deps/xvfb-…
+            let profile_dir = exe.parent().and_then(Path::parent).expect("profile directory");
+            let target = profile_dir.parent().expect("target directory");
+            let release = profile_dir.file_name().is_some_and(|n| n == "release");
+            let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+            let mut cmd = Command::new(cargo);
+            cmd.args(["build", "-p", "rt-gl", "--lib"]).env("CARGO_TARGET_DIR", target);
+            if release {
+                cmd.arg("--release");
+            }
+            let status = cmd.status().expect("run cargo");
+            assert!(status.success(), "building rt-gl's cdylib failed");
+            let lib = profile_dir.join("librt_gl.so");
+            assert!(lib.exists(), "{} not built", lib.display());
+            lib
+        })
+        .clone()
 }
 
 fn tool(name: &str) -> PathBuf {
