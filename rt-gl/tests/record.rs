@@ -1,7 +1,7 @@
 //! The recorder and the renderer without any GL: calls fed directly, as
 //! the interposer feeds them.
 
-use glam::{Mat4, Vec3, Vec4};
+use rt_core::glam::{Mat4, Vec3, Vec4};
 use rt_gl::{
     gl,
     record::{Command, Recorder, arrays, frustum, ortho, rotate, translate},
