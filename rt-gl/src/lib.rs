@@ -17,13 +17,15 @@
 //!   turns draws into geometry; display lists are recorded once and
 //!   instanced on every call.
 //! - [`render`]: the frame ray traced per pixel with GL's lighting
-//!   equation (`gl` mode) or with shadows and ambient occlusion too (`rt`).
+//!   equation (`gl` mode) or with shadows, ambient occlusion and mirror
+//!   reflections too (`rt`).
 //! - The interposer itself (exported `gl*`/`glX*` symbols) is in the
 //!   `cdylib`; it never lets a panic reach the program, and any error
 //!   leaves that frame as the real GL drew it, logged once to stderr.
 //!
 //! Settings (environment variables, read once): `RT_GL_MODE=gl|rt`,
-//! `RT_GL_SHADOWS=0|1`, `RT_GL_AO=<rays per pixel>`, `RT_GL_THREADS=<n>`,
+//! `RT_GL_SHADOWS=0|1`, `RT_GL_AO=<rays per pixel>`, `RT_GL_MIRROR=<0..1>`
+//! (reflections of the specular colour in `rt` mode), `RT_GL_THREADS=<n>`,
 //! `RT_GL_DUMP=<dir>` (each frame as `rt-NNNN.png`, counters in
 //! `counters.txt`), `RT_GL_DUMP_RASTER=1` (also what the real GL drew, as
 //! `raster-NNNN.png`), `RT_GL_STATS=1` (counters per frame on stderr).
@@ -95,6 +97,15 @@ impl Config {
                 _ => {
                     log_once("RT_GL_AO", &format!("RT_GL_AO={v}: expected 0..=1024 rays; using 8"))
                 }
+            }
+        }
+        if let Some(v) = var("RT_GL_MIRROR") {
+            match v.parse::<f32>() {
+                Ok(k) if (0.0..=1.0).contains(&k) => options.mirror = k,
+                _ => log_once(
+                    "RT_GL_MIRROR",
+                    &format!("RT_GL_MIRROR={v}: expected 0..=1; using 0.5"),
+                ),
             }
         }
         let pool = var("RT_GL_THREADS").and_then(|v| match v.parse::<usize>() {

@@ -1,8 +1,9 @@
 //! Ray tracing a recorded frame: one ray per pixel through the program's
 //! own projection, shaded with the fixed-function lighting equation
 //! (OpenGL 2.1 specification §2.14.1) evaluated per pixel; in
-//! [`Mode::Rt`] with shadow rays toward every light and ambient
-//! occlusion on the ambient terms.
+//! [`Mode::Rt`] with shadow rays toward every light, ambient occlusion on
+//! the ambient terms and mirror reflections weighted by the specular
+//! colour.
 //!
 //! Why not rt-surface's shading: GL's material has separate ambient,
 //! diffuse, specular and emissive colours, unlit primitives show their
@@ -43,11 +44,23 @@ pub struct Options {
     pub ao_samples: u32,
     /// Longest AO ray, as a fraction of the scene's diagonal.
     pub ao_distance: f32,
+    /// Mirror reflections (`Rt` mode): a surface reflects its specular
+    /// colour times this (0: off), up to `bounces` deep.
+    pub mirror: f32,
+    /// Deepest reflection.
+    pub bounces: u32,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Self { mode: Mode::Gl, shadows: true, ao_samples: 8, ao_distance: 0.2 }
+        Self {
+            mode: Mode::Gl,
+            shadows: true,
+            ao_samples: 8,
+            ao_distance: 0.2,
+            mirror: 0.5,
+            bounces: 2,
+        }
     }
 }
 
@@ -226,7 +239,8 @@ impl FrameScene {
                 let c = match self.closest(&ray) {
                     Some((src, hit)) => {
                         let seed = (y as u64) << 32 | x as u64;
-                        to_rgba8(self.shade(&ray, src, &hit, lighting, opts, seed))
+                        let ctx = ShadeCtx { lighting, opts, background, seed };
+                        to_rgba8(self.shade(&ray, src, &hit, &ctx, 0))
                     }
                     None => bg,
                 };
@@ -288,15 +302,8 @@ impl FrameScene {
     }
 
     /// GL's lighting equation at `hit`, per pixel.
-    fn shade(
-        &self,
-        ray: &Ray,
-        src: Source,
-        hit: &Hit,
-        lighting: &Lighting,
-        opts: &Options,
-        seed: u64,
-    ) -> Vec4 {
+    fn shade(&self, ray: &Ray, src: Source, hit: &Hit, ctx: &ShadeCtx<'_>, depth: u32) -> Vec4 {
+        let ShadeCtx { lighting, opts, seed, .. } = *ctx;
         let (sh, color, normal) = self.surface(src, hit);
         if !sh.lit {
             return color;
@@ -316,13 +323,15 @@ impl FrameScene {
         let geo_n = if back { -hit.normal } else { hit.normal };
         let m = sh.material_with(color);
         let rt = opts.mode == Mode::Rt;
-        let ambient_visibility = if rt && opts.ao_samples > 0 && self.diagonal > 0.0 {
+        let ambient_visibility = if rt && depth == 0 && opts.ao_samples > 0 && self.diagonal > 0.0 {
             self.ambient_visibility(hit, geo_n, opts, seed)
         } else {
             1.0
         };
         let p = hit.position;
-        let eye = Vec3::Z; // GL's default infinite viewer
+        // GL's default infinite viewer for what the camera sees; the
+        // incoming ray's direction for what a mirror shows.
+        let eye = if depth == 0 { Vec3::Z } else { -ray.direction.normalize_or_zero() };
         let mut c = m.emission + m.ambient * lighting.model_ambient * ambient_visibility;
         for l in lighting.lights.iter().filter(|l| l.enabled) {
             let (to_light, attenuation, target) = if l.position.w == 0.0 {
@@ -369,6 +378,19 @@ impl FrameScene {
             let spec = if m.shininess == 0.0 { 1.0 } else { ndh.powf(m.shininess) };
             c += k * spec * l.specular * m.specular;
         }
+        let spec = m.specular.truncate() * opts.mirror;
+        if rt && depth < opts.bounces && spec.max_element() > 0.0 {
+            let d = ray.direction.normalize_or_zero();
+            let r = d - 2.0 * d.dot(n) * n;
+            // Leave on the side the reflection goes to.
+            let side = if r.dot(geo_n) >= 0.0 { geo_n } else { -geo_n };
+            let bounce = spawn_ray(p, hit.position_error, side, r);
+            let seen = match self.closest(&bounce) {
+                Some((s2, h2)) => self.shade(&bounce, s2, &h2, ctx, depth + 1),
+                None => ctx.background,
+            };
+            c += (spec * seen.truncate()).extend(0.0);
+        }
         c.truncate().extend(m.diffuse.w)
     }
 
@@ -389,6 +411,16 @@ impl FrameScene {
         }
         open as f32 / opts.ao_samples as f32
     }
+}
+
+/// What every shading call of one frame shares.
+#[derive(Clone, Copy)]
+struct ShadeCtx<'a> {
+    lighting: &'a Lighting,
+    opts: &'a Options,
+    background: Vec4,
+    /// The pixel's seed (AO directions).
+    seed: u64,
 }
 
 fn to_rgba8(c: Vec4) -> [u8; 4] {

@@ -391,3 +391,36 @@ fn settings_fall_back_on_unreadable_values() {
     assert_eq!(bad.options, Options::default());
     assert!(bad.pool.is_none() && bad.dump.is_none() && !bad.stats);
 }
+
+/// In `rt` mode a specular surface mirrors what it faces, weighted by its
+/// specular colour and `mirror`: a floor facing the empty sky gains
+/// half the (blue) background in blue only; `gl` mode has no reflection.
+#[test]
+fn rt_mode_mirrors_specular_surfaces() {
+    let mut r = Recorder::new();
+    r.command(Command::MatrixMode(gl::PROJECTION));
+    r.command(Command::MultMatrix(ortho(-2.0, 2.0, -2.0, 2.0, -10.0, 10.0).unwrap()));
+    r.command(Command::MatrixMode(gl::MODELVIEW));
+    r.command(Command::Enable(gl::LIGHTING));
+    r.command(Command::Enable(gl::LIGHT0));
+    r.command(Command::Light(gl::LIGHT0, gl::SPECULAR, Vec4::new(0.0, 0.0, 0.0, 1.0)));
+    r.command(Command::Material(gl::FRONT, gl::AMBIENT_AND_DIFFUSE, Vec4::new(0.2, 0.2, 0.2, 1.0)));
+    r.command(Command::Material(gl::FRONT, gl::SPECULAR, Vec4::ONE));
+    r.command(Command::Normal(Vec3::Z));
+    let floor = [
+        Vec3::new(-3.0, -3.0, -1.0),
+        Vec3::new(3.0, -3.0, -1.0),
+        Vec3::new(3.0, 3.0, -1.0),
+        Vec3::new(-3.0, 3.0, -1.0),
+    ];
+    draw(&mut r, gl::QUADS, &floor);
+    let scene = FrameScene::build(&r.end_frame()).unwrap();
+    let sky = Vec4::new(0.0, 0.0, 1.0, 1.0);
+    let render = |mode| {
+        let opts = Options { mode, ao_samples: 0, shadows: false, ..Options::default() };
+        scene.render(&r.lighting, r.projection(), 16, 16, sky, &opts).unwrap()
+    };
+    // 0.2·0.2 ambient + 0.2·1 diffuse = 0.24 → 61; plus 0.5 · 1 · sky.
+    assert_eq!(render(Mode::Gl).get(8, 8), Some([61, 61, 61, 255]));
+    assert_eq!(render(Mode::Rt).get(8, 8), Some([61, 61, 189, 255]));
+}
