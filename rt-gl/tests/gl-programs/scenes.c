@@ -140,6 +140,18 @@ static int grid(int nx, int ny, float **pos, float **nrm, unsigned **idx) {
     return nv;
 }
 
+/* The grid in three new buffer objects b: positions, normals, indices. */
+static void upload_grid(int nx, int ny, GLuint b[3], float **pos, float **nrm, unsigned **idx) {
+    int nv = grid(nx, ny, pos, nrm, idx);
+    glGenBuffers(3, b);
+    glBindBuffer(GL_ARRAY_BUFFER, b[0]);
+    glBufferData(GL_ARRAY_BUFFER, sizeof(float) * 3 * nv, *pos, GL_STATIC_DRAW);
+    glBindBuffer(GL_ARRAY_BUFFER, b[1]);
+    glBufferData(GL_ARRAY_BUFFER, sizeof(float) * 3 * nv, *nrm, GL_STATIC_DRAW);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, b[2]);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, sizeof(unsigned) * 6 * nx * ny, *idx, GL_STATIC_DRAW);
+}
+
 static GLuint lists;
 static GLuint vbo[3];
 static float *gpos, *gnrm;
@@ -157,16 +169,9 @@ static void setup(void) {
     material(0.2f, 0.5f, 0.9f);
     sphere(0.4f, 24, 12);
     glEndList();
-    /* A static VBO grid with an element buffer. */
-    grid(gnx, gny, &gpos, &gnrm, &gidx);
-    int nv = (gnx + 1) * (gny + 1);
-    glGenBuffers(3, vbo);
-    glBindBuffer(GL_ARRAY_BUFFER, vbo[0]);
-    glBufferData(GL_ARRAY_BUFFER, sizeof(float) * 3 * nv, gpos, GL_STATIC_DRAW);
-    glBindBuffer(GL_ARRAY_BUFFER, vbo[1]);
-    glBufferData(GL_ARRAY_BUFFER, sizeof(float) * 3 * nv, gnrm, GL_STATIC_DRAW);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, vbo[2]);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, sizeof(unsigned) * 6 * gnx * gny, gidx, GL_STATIC_DRAW);
+    /* A static VBO grid with an element buffer (the arrays are kept for
+       the client-memory scene too). */
+    upload_grid(gnx, gny, vbo, &gpos, &gnrm, &gidx);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
 }
@@ -404,15 +409,8 @@ static double mesh_frames(int n, int frames) {
     if (ny < 1) ny = 1;
     float *p, *nr;
     unsigned *idx;
-    int nv = grid(nx, ny, &p, &nr, &idx);
     GLuint b[3];
-    glGenBuffers(3, b);
-    glBindBuffer(GL_ARRAY_BUFFER, b[0]);
-    glBufferData(GL_ARRAY_BUFFER, sizeof(float) * 3 * nv, p, GL_STATIC_DRAW);
-    glBindBuffer(GL_ARRAY_BUFFER, b[1]);
-    glBufferData(GL_ARRAY_BUFFER, sizeof(float) * 3 * nv, nr, GL_STATIC_DRAW);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, b[2]);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, sizeof(unsigned) * 6 * nx * ny, idx, GL_STATIC_DRAW);
+    upload_grid(nx, ny, b, &p, &nr, &idx);
     printf("triangles %d\n", 2 * nx * ny);
     for (int f = 0; f < frames; f++) {
         double t0 = now();
