@@ -424,3 +424,26 @@ fn rt_mode_mirrors_specular_surfaces() {
     assert_eq!(render(Mode::Gl).get(8, 8), Some([61, 61, 61, 255]));
     assert_eq!(render(Mode::Rt).get(8, 8), Some([61, 61, 189, 255]));
 }
+
+/// Lists that call each other twice over ask for 2⁶⁴ commands within
+/// GL's nesting limit: the call stops at the budget instead of hanging,
+/// and the recorder keeps working.
+#[test]
+fn mutually_recursive_lists_stop_at_the_budget() {
+    let mut r = Recorder::new();
+    for (id, other) in [(1, 2), (2, 1)] {
+        r.new_list(id, gl::COMPILE);
+        draw(&mut r, gl::TRIANGLES, &[Vec3::ZERO, Vec3::X, Vec3::Y]);
+        r.command(Command::CallList(other));
+        r.command(Command::CallList(other));
+        r.end_list();
+    }
+    r.set_list_budget(10_000);
+    r.command(Command::CallList(1));
+    assert!(r.counters.ignored > 0);
+    let tris = r.end_frame().flatten().triangles.len();
+    assert!(tris > 100 && tris < 10_000, "{tris} triangles");
+    // The next call gets a fresh budget.
+    r.command(Command::CallList(2));
+    assert!(!r.end_frame().is_empty());
+}

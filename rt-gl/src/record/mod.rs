@@ -406,6 +406,10 @@ pub struct Counters {
     pub ignored: u64,
 }
 
+/// Commands one top-level display-list call may execute (see
+/// [`Recorder::set_list_budget`]): 2²⁶, several times the largest lists
+/// real programs compile.
+pub const LIST_BUDGET: u64 = 1 << 26;
 /// Deepest `glCallList` nesting executed (GL's minimum `GL_MAX_LIST_NESTING`).
 pub const MAX_LIST_NESTING: u32 = 64;
 /// Deepest matrix stack kept (GL guarantees 32 modelview entries).
@@ -566,6 +570,9 @@ pub struct Recorder {
     /// > 0 while replaying a cached list for its state changes only.
     state_only: u32,
     depth: u32,
+    /// Commands the current top-level list call may still execute.
+    budget: u64,
+    list_budget: u64,
     cache: HashMap<u32, Vec<(Inherited, Arc<Recorded>)>>,
     frame: Frame,
     /// Vertex arrays and buffer objects.
@@ -610,6 +617,8 @@ impl Recorder {
             capture: None,
             state_only: 0,
             depth: 0,
+            budget: LIST_BUDGET,
+            list_budget: LIST_BUDGET,
             cache: HashMap::new(),
             frame: Frame::default(),
             arrays: ArrayState::default(),
@@ -984,6 +993,9 @@ impl Recorder {
         let Some(list) = self.lists.get(&id).cloned() else {
             return;
         };
+        if self.depth == 0 {
+            self.budget = self.list_budget;
+        }
         self.depth += 1;
         let mv = self.modelview();
         let plain = self.state_only == 0 && self.capture.is_none() && self.begin.is_none();
@@ -1057,8 +1069,24 @@ impl Recorder {
 
     fn run(&mut self, commands: &[Command]) {
         for c in commands {
+            if self.depth > 0 {
+                // Inside a list call: spend the call's budget.
+                if self.budget == 0 {
+                    self.counters.ignored += 1;
+                    return;
+                }
+                self.budget -= 1;
+            }
             self.execute(c);
         }
+    }
+
+    /// Most commands one top-level `glCallList` may execute, nested calls
+    /// included (default [`LIST_BUDGET`]): lists that call each other
+    /// several times over can ask for 2⁶⁴ commands within GL's nesting
+    /// limit; past the budget the call stops, counted as ignored.
+    pub fn set_list_budget(&mut self, commands: u64) {
+        self.list_budget = commands;
     }
 }
 
