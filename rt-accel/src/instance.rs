@@ -223,41 +223,44 @@ impl<O: Object> Instances<O> {
             return None;
         }
         let mut best: Option<(u32, Hit)> = None;
-        let mut stack = [0u32; TOP_STACK];
-        let mut sp = 1;
+        let t_max = |best: &Option<(u32, Hit)>| best.map_or(ray.t_max, |(_, h)| h.t);
+        let entry = |c: u32, t_max: f32| {
+            self.nodes[c as usize].bounds.intersect_ray(&Ray { t_max, ..*ray }).map(|(t, _)| t)
+        };
+        // Nodes with the distance at which the ray enters their box: each
+        // box is tested once, when its parent is opened.
+        let mut stack = [(0u32, 0.0f32); TOP_STACK];
+        let mut sp = 0;
+        if let Some(t) = entry(0, ray.t_max) {
+            stack[0] = (0, t);
+            sp = 1;
+        }
         while sp > 0 {
             sp -= 1;
-            let node = self.nodes[stack[sp] as usize];
-            let t_max = best.map_or(ray.t_max, |(_, h)| h.t);
-            if node.bounds.intersect_ray(&Ray { t_max, ..*ray }).is_none() {
+            let (at, t_entry) = stack[sp];
+            if t_entry > t_max(&best) {
                 continue;
             }
+            let node = self.nodes[at as usize];
             if node.count == 0 {
-                // Visit the nearer child first.
+                // Push the farther child first: the nearer is opened next.
+                let bound = t_max(&best);
                 let (a, b) = (node.first, node.first + 1);
-                let near = |c: u32| {
-                    self.nodes[c as usize]
-                        .bounds
-                        .intersect_ray(&Ray { t_max, ..*ray })
-                        .map(|(t, _)| t)
-                };
-                let (ta, tb) = (near(a), near(b));
-                let (first, second) = if tb.unwrap_or(f32::INFINITY) < ta.unwrap_or(f32::INFINITY) {
-                    (b, a)
-                } else {
-                    (a, b)
-                };
-                for c in [second, first] {
-                    if sp < TOP_STACK {
-                        stack[sp] = c;
+                let mut kids = [(a, entry(a, bound)), (b, entry(b, bound))];
+                if kids[1].1.unwrap_or(f32::INFINITY) < kids[0].1.unwrap_or(f32::INFINITY) {
+                    kids.swap(0, 1);
+                }
+                for (c, t) in kids.into_iter().rev() {
+                    if let (Some(t), true) = (t, sp < TOP_STACK) {
+                        stack[sp] = (c, t);
                         sp += 1;
                     }
                 }
                 continue;
             }
             for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                let t_max = best.map_or(ray.t_max, |(_, h)| h.t);
-                if let Some(h) = self.hit_instance(i, &Ray { t_max, ..*ray }) {
+                let r = Ray { t_max: t_max(&best), ..*ray };
+                if let Some(h) = self.hit_instance(i, &r) {
                     let better = best.is_none_or(|(bi, bh)| h.t < bh.t || (h.t == bh.t && i < bi));
                     if better {
                         best = Some((i, h));

@@ -72,7 +72,7 @@ fn present_frame(buffer: u32) {
         let _ = std::fs::write(dir.join("counters.txt"), line);
     }
     let rendered = crate::catch(|| {
-        let scene = FrameScene::build(&frame)?;
+        let scene = FrameScene::build(frame)?;
         let render =
             || scene.render(&lighting, projection, w as u32, h as u32, background, &cfg.options);
         match &cfg.pool {

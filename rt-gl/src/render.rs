@@ -167,7 +167,7 @@ impl FrameScene {
     /// # Errors
     /// [`RenderError::Build`] if a primitive is not finite;
     /// [`RenderError::Instance`] if a transform is singular.
-    pub fn build(frame: &Frame) -> Result<Self, RenderError> {
+    pub fn build(frame: Frame) -> Result<Self, RenderError> {
         let scene = frame.immediate.build()?;
         let mut objects: Vec<Arc<Recorded>> = Vec::new();
         let mut placements = Vec::with_capacity(frame.instances.len());
@@ -186,7 +186,7 @@ impl FrameScene {
         let instances = Instances::new(objects, &placements).map_err(RenderError::Instance)?;
         let b = Object::bounds(&scene).union(instances.bounds());
         let diagonal = if b.is_empty() { 0.0 } else { (b.max - b.min).length() };
-        Ok(Self { immediate: frame.immediate.clone(), scene, instances, normal, diagonal })
+        Ok(Self { immediate: frame.immediate, scene, instances, normal, diagonal })
     }
 
     /// The closest hit among the immediate geometry and the instances.

@@ -103,7 +103,7 @@ fn trace(r: &Recorder, mode: Mode) {
     let frame = r.frame().clone();
     // Building may refuse non-finite geometry; rendering may refuse the
     // view: both are errors, not panics.
-    if let Ok(scene) = FrameScene::build(&frame) {
+    if let Ok(scene) = FrameScene::build(frame) {
         let opts = Options { mode, ao_samples: 2, ..Options::default() };
         let _ = scene.render(&r.lighting, r.projection(), 12, 9, Vec4::ZERO, &opts);
     }

@@ -257,7 +257,7 @@ fn pixels_follow_the_fixed_function_lighting_equation() {
         &[Vec3::new(-4.0, -4.0, -3.0), Vec3::new(4.0, -4.0, -3.0), Vec3::new(0.0, 4.0, -3.0)],
     );
     let frame = r.end_frame();
-    let scene = FrameScene::build(&frame).expect("finite");
+    let scene = FrameScene::build(frame).expect("finite");
     let img = scene
         .render(
             &r.lighting,
@@ -284,7 +284,7 @@ fn pixels_follow_the_fixed_function_lighting_equation() {
         gl::TRIANGLES,
         &[Vec3::new(-4.0, -4.0, -3.0), Vec3::new(4.0, -4.0, -3.0), Vec3::new(0.0, 4.0, -3.0)],
     );
-    let scene = FrameScene::build(&r.end_frame()).unwrap();
+    let scene = FrameScene::build(r.end_frame()).unwrap();
     let img =
         scene.render(&r.lighting, r.projection(), 32, 32, Vec4::ZERO, &Options::default()).unwrap();
     assert_eq!(img.get(16, 16), Some([51, 102, 153, 255]));
@@ -309,7 +309,7 @@ fn rt_mode_adds_shadows_deterministically() {
     };
     draw(&mut r, gl::QUADS, &square(2.0, -1.0));
     draw(&mut r, gl::QUADS, &square(0.3, 1.0));
-    let scene = FrameScene::build(&r.end_frame()).unwrap();
+    let scene = FrameScene::build(r.end_frame()).unwrap();
     let render = |mode, threads: usize| {
         let opts = Options { mode, ao_samples: 4, ..Options::default() };
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
@@ -348,7 +348,7 @@ fn bad_views_and_vertices_are_refused() {
     r.command(Command::End);
     let f = r.end_frame();
     assert!(f.is_empty());
-    let scene = FrameScene::build(&f).unwrap();
+    let scene = FrameScene::build(f).unwrap();
     let l = r.lighting.clone();
     let o = Options::default();
     assert_eq!(scene.render(&l, Mat4::ZERO, 8, 8, Vec4::ZERO, &o), Err(RenderError::BadProjection));
@@ -414,7 +414,7 @@ fn rt_mode_mirrors_specular_surfaces() {
         Vec3::new(-3.0, 3.0, -1.0),
     ];
     draw(&mut r, gl::QUADS, &floor);
-    let scene = FrameScene::build(&r.end_frame()).unwrap();
+    let scene = FrameScene::build(r.end_frame()).unwrap();
     let sky = Vec4::new(0.0, 0.0, 1.0, 1.0);
     let render = |mode| {
         let opts = Options { mode, ao_samples: 0, shadows: false, ..Options::default() };
