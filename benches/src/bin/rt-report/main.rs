@@ -98,9 +98,26 @@ fn index(sections: &[(&str, Section)], quick: bool, seconds: f64) -> String {
     out
 }
 
+const USAGE: &str = "usage: rt-report [AREA ...] [--quick]
+
+Writes tables, CSV files and plots under target/rt-report/.
+AREA: traversal, grin, octree, schlieren, noise, render, composite (none or
+`all`: every one of these, plus target/rt-report/index.md), or gl (rt-gl
+against Mesa; needs xvfb-run, cc and glxgears; not part of `all`).
+--quick: smaller problems, fewer repetitions (checks the pipeline, not the
+targets).";
+
 fn main() -> ExitCode {
     let t0 = std::time::Instant::now();
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "--help" || a == "-h") {
+        println!("{USAGE}");
+        return ExitCode::SUCCESS;
+    }
+    if let Some(bad) = args.iter().find(|a| a.starts_with('-') && *a != "--quick") {
+        eprintln!("rt-report: unknown option `{bad}` (known: --quick, --help)\n\n{USAGE}");
+        return ExitCode::from(2);
+    }
     let quick = args.iter().any(|a| a == "--quick");
     let areas: Vec<&str> =
         args.iter().filter(|a| !a.starts_with("--")).map(String::as_str).collect();
