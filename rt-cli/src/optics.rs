@@ -201,7 +201,8 @@ impl Volume {
     }
 
     /// The deflections the bench will see: one photon per pixel of a
-    /// coarse film, no cutoff, the mean deflection per pixel.
+    /// coarse film, no cutoff, the mean deflection per pixel, traced
+    /// without skipping (so weak flows are measured too).
     ///
     /// # Errors
     /// As [`Volume::render`].
@@ -211,7 +212,11 @@ impl Volume {
         let mut film = Film::new(WIDTH, height as usize, Filter::Box)?;
         let probe =
             Bench { mode: Mode::Schlieren(Cutoff::None), film_distance: 0.0, ..bench.clone() };
-        self.pass(&probe, &mut film, 0, 0x5eed)?;
+        // Every step traced, no octree skipping: a bench without cutoff
+        // and with the film in the image plane cannot see deflections, so
+        // its skipping tolerance (1e-3 rad) would hide every deflection
+        // below it, i.e. all of a weak flow's. 96 photons a row: cheap.
+        probe.render(&self.field, &mut film, 0, 0x5eed)?;
         Ok(Survey {
             eps: film.mean_deflection(),
             width: WIDTH,
@@ -328,5 +333,35 @@ mod tests {
         assert_eq!(lattice(64), (4, 4));
         assert_eq!(lattice(256), (8, 4));
         assert_eq!(lattice(65536), (64, 16));
+    }
+
+    /// A weak flow (a Gaussian density bump, peak deflection 1e-4 rad,
+    /// below the skipping tolerance of a bench without cutoff) is
+    /// measured, not skipped: the survey's largest deflection is the
+    /// analytic `K·A·√(2π)·e^(−1/2)` of the bump (ORACLES §5) within the
+    /// coarse survey's sampling. Before, it read 0, so the automatic
+    /// exposure saturated knife-edge images and put the shadowgraph film
+    /// at 0 m.
+    #[test]
+    fn the_survey_measures_weak_flows() {
+        let (n, h, sigma, amp) = (48usize, 1.5e-3, 8e-3, 0.3);
+        let c = 0.5 * (n as f64 - 1.0) * h;
+        let mut data = Vec::with_capacity(n * n * n);
+        for k in 0..n {
+            for j in 0..n {
+                for i in 0..n {
+                    let p = DVec3::new(i as f64, j as f64, k as f64) * h - c;
+                    data.push(
+                        (1.2 + amp * (-p.length_squared() / (2.0 * sigma * sigma)).exp()) as f32,
+                    );
+                }
+            }
+        }
+        let grid = Grid::new([n; 3], DVec3::ZERO, DVec3::splat(h), data).unwrap();
+        let v = Volume::density(grid, Interpolation::Cubic).unwrap();
+        let survey = v.survey(&v.bench(Axis::Z, Mode::Schlieren(Cutoff::None), 0.0)).unwrap();
+        let exact = GLADSTONE_DALE_AIR * amp * (core::f64::consts::TAU).sqrt() * (-0.5f64).exp();
+        let got = survey.magnitude(1.0);
+        assert!((got / exact - 1.0).abs() < 0.1, "survey max |ε| {got:e}, analytic {exact:e}");
     }
 }
