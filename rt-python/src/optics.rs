@@ -1,0 +1,135 @@
+//! The optical bench: schlieren (every cutoff), shadowgraph,
+//! interferometry and colour schlieren of a volume, set up as `rt
+//! schlieren` sets it up (the same defaults, the same automatic exposure,
+//! the same photons), so both give the same image for the same options.
+
+use std::path::PathBuf;
+
+use clap::ValueEnum;
+use numpy::{IntoPyArray, PyArray3, ndarray::Array3};
+use pyo3::prelude::*;
+use rt_cli::{
+    optics::{Axis, Interpolation, Quantity, Samples},
+    schlieren::{Args, CutoffKind, Estimator, prepare},
+};
+use rt_photo::{Bench, Mode, Reconstruction};
+use rt_volume::GLADSTONE_DALE_AIR;
+
+use crate::{value_error, volume::PyVolume};
+
+/// Longest image side, as `rt schlieren --size` allows.
+const MAX_EDGE: u32 = 16384;
+
+/// The value of enum `E` named `s` (as the command line spells it).
+fn parse<E: ValueEnum>(what: &str, s: &str) -> PyResult<E> {
+    E::from_str(s, false).map_err(|_| {
+        let known: Vec<String> = E::value_variants()
+            .iter()
+            .filter_map(|v| v.to_possible_value().map(|p| p.get_name().to_string()))
+            .collect();
+        value_error(format!("{what}: unknown `{s}` (known: {})", known.join(", ")))
+    })
+}
+
+/// `Err` unless `v` is finite and `> 0`.
+fn positive(name: &str, v: f64) -> PyResult<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(value_error(format!("{name} must be finite and > 0 (got {v})")))
+    }
+}
+
+/// The film as `(image [h, w, 3] relative to an undisturbed beam with
+/// nothing cut, in the f64 the film accumulates in, mean deflection [h, w, 2] in radians (NaN where no photon
+/// landed), the image of an undisturbed beam through the optics (RGB), a
+/// line saying which optics were chosen)`.
+type Optics<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f32>>, [f32; 3], String);
+
+/// Renders `volume` on the bench the arguments describe.
+#[pyfunction]
+#[pyo3(name = "_optics")]
+#[pyo3(signature = (volume, cutoff, angle, f, h, radius, half_range, wavelength, fringe_spacing, film_distance, axis, size, photons, seed, estimator))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn optics<'py>(
+    py: Python<'py>,
+    volume: &PyVolume,
+    cutoff: &str,
+    angle: f64,
+    f: f64,
+    h: Option<f64>,
+    radius: Option<f64>,
+    half_range: Option<f64>,
+    wavelength: f64,
+    fringe_spacing: Option<f64>,
+    film_distance: Option<f64>,
+    axis: &str,
+    size: u32,
+    photons: u32,
+    seed: u64,
+    estimator: &str,
+) -> PyResult<Optics<'py>> {
+    if !angle.is_finite() {
+        return Err(value_error(format!("angle must be finite (got {angle})")));
+    }
+    if let Some(d) = film_distance.filter(|d| !d.is_finite()) {
+        return Err(value_error(format!("film_distance must be finite (got {d})")));
+    }
+    if !(1..=MAX_EDGE).contains(&size) {
+        return Err(value_error(format!("size must be 1 to {MAX_EDGE} pixels (got {size})")));
+    }
+    if !(1..=65536).contains(&photons) {
+        return Err(value_error(format!("photons must be 1 to 65536 per pixel (got {photons})")));
+    }
+    let args = Args {
+        file: PathBuf::new(),
+        samples: Samples { quantity: Quantity::Density, k: GLADSTONE_DALE_AIR },
+        allow_nonphysical: false,
+        cutoff: parse::<CutoffKind>("cutoff", cutoff)?,
+        angle,
+        f: positive("f", f)?,
+        h: h.map(|v| positive("h", v)).transpose()?,
+        radius: radius.map(|v| positive("radius", v)).transpose()?,
+        half_range: half_range.map(|v| positive("half_range", v)).transpose()?,
+        lambda: positive("wavelength", wavelength)?,
+        fringes: fringe_spacing.map(|v| positive("fringe_spacing", v)).transpose()?,
+        film_distance,
+        axis: parse::<Axis>("axis", axis)?,
+        size,
+        photons,
+        estimator: parse::<Estimator>("estimator", estimator)?,
+        interp: Interpolation::Linear,
+        seed,
+        out: PathBuf::new(),
+        figure: false,
+        no_figure: true,
+        raw16: false,
+    };
+    let v = &volume.inner;
+    let (film, background, chosen) = py
+        .detach(|| -> anyhow::Result<_> {
+            let (bench, chosen) = prepare(v, &args)?;
+            let bench = match args.estimator {
+                Estimator::Sheet => bench,
+                Estimator::Photons => Bench { reconstruction: Reconstruction::Photons, ..bench },
+            };
+            let background = match &bench.mode {
+                Mode::Schlieren(c) => c.transmit(0.0, 0.0),
+                // Infinite fringe: the undisturbed beam is bright.
+                Mode::Interferometry { .. } => [1.0; 3],
+            };
+            let (film, _) = v.render(&bench, size as usize, photons, seed)?;
+            Ok((film, background, chosen))
+        })
+        .map_err(value_error)?;
+    let (w, h) = (film.width(), film.height());
+    let rgb: Vec<f64> = film.normalized_f64().into_iter().flatten().collect();
+    let eps: Vec<f32> = film
+        .mean_deflection()
+        .into_iter()
+        .flat_map(|e| e.map_or([f32::NAN; 2], |(u, v)| [u as f32, v as f32]))
+        .collect();
+    let image = Array3::from_shape_vec((h, w, 3), rgb).map_err(value_error)?;
+    let deflection = Array3::from_shape_vec((h, w, 2), eps).map_err(value_error)?;
+    Ok((image.into_pyarray(py), deflection.into_pyarray(py), background, chosen))
+}

@@ -1,0 +1,41 @@
+"""`composite_mpi` over real MPI processes (mpirun + mpi4py)."""
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+SCRIPT = Path(__file__).with_name("mpi_composite.py")
+
+mpirun = shutil.which("mpirun")
+try:
+    import mpi4py  # noqa: F401
+except ImportError:
+    mpi4py = None
+
+needs_mpi = pytest.mark.skipif(mpirun is None or mpi4py is None, reason="needs mpirun and mpi4py")
+
+
+def run(n, mode):
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    return subprocess.run([mpirun, "--oversubscribe", "-np", str(n), sys.executable, str(SCRIPT), mode],
+                          capture_output=True, text=True, timeout=120, env=env)
+
+
+@needs_mpi
+@pytest.mark.parametrize("n", [1, 2, 3, 4])
+def test_ranks_composite_to_the_whole_scene_bit_for_bit(n):
+    r = run(n, "compose")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert f"OK {n} ranks" in r.stdout
+
+
+@needs_mpi
+def test_a_silent_rank_is_an_error_on_the_others_not_a_hang():
+    r = run(3, "silent")
+    assert r.returncode == 0, r.stdout + r.stderr
+    for rank in (0, 2):
+        assert f"rank {rank}: ValueError: compositing failed" in r.stdout, r.stdout + r.stderr

@@ -1,0 +1,158 @@
+"""The optical bench from Python against ORACLES §5's Gaussian bump, and
+against the `rt` command's own output for the same volume and seed."""
+
+import json
+import math
+import subprocess
+
+import numpy as np
+import pytest
+
+import rtvis
+from helpers import bump, bump_deflection, pixel_centres, read_png16, rt_binary
+
+
+@pytest.fixture(scope="module")
+def gaussian():
+    return bump()
+
+
+def test_deflection_matches_the_analytic_bump(gaussian):
+    vol, sigma, delta = gaussian
+    _, eps = rtvis.schlieren(vol, f=1.0, h=4e-4, size=96, deflection=True)
+    ex, ey = bump_deflection(*pixel_centres(vol, eps.shape[:2]), sigma, delta)
+    peak = np.abs(ex).max()
+    # First order in δ, a bump truncated at 4σ, cubic interpolation of 1 mm
+    # samples: within 1.5 % of the peak everywhere.
+    assert np.abs(eps[..., 0] - ex).max() < 0.015 * peak
+    assert np.abs(eps[..., 1] - ey).max() < 0.015 * peak
+
+
+def test_knife_edge_matches_the_analytic_signal(gaussian):
+    vol, sigma, delta = gaussian
+    f, h = 1.0, 4e-4
+    img = rtvis.schlieren(vol, cutoff="knife", angle=0.0, f=f, h=h, size=128)
+    assert img.dtype == np.float32 and img.shape == (128, 128)
+    ex, _ = bump_deflection(*pixel_centres(vol, img.shape), sigma, delta)
+    expected = 2.0 * np.clip(0.5 + (f / h) * ex, 0.0, 1.0)
+    # Normalised to the background: 1 where nothing deflects.
+    assert img[0, 0] == pytest.approx(1.0, abs=1e-6)
+    assert np.abs(img - expected).max() < 0.02
+    # The signal is strong (up to ±0.76 about the background), so the
+    # bound above is a real check: a sign or axis error would be ~1.5.
+    assert np.abs(expected - 1.0).max() > 0.7
+
+
+def test_shadowgraph_matches_the_linearised_oracle(gaussian):
+    vol, sigma, delta = gaussian
+    L = 2.0
+    img = rtvis.shadowgraph(vol, distance=L, size=64, photons=64)
+    X, Y = pixel_centres(vol, img.shape)
+    r2 = (X**2 + Y**2) / sigma**2
+    A = math.sqrt(2 * math.pi) * delta / sigma
+    expected = 1.0 + L * A * np.exp(-r2 / 2) * (2.0 - r2)
+    contrast = np.abs(expected - 1.0).max()
+    assert contrast > 0.05
+    # Linearised in L·δ: the exact intensity differs by O(contrast²).
+    assert np.abs(img - expected).max() < 0.2 * contrast
+
+
+def test_interferogram_phase_matches_the_oracle(gaussian):
+    vol, sigma, delta = gaussian
+    lam = 10.6e-6
+    img = rtvis.interferogram(vol, wavelength=lam, size=128, dtype=np.float64)
+    X, Y = pixel_centres(vol, img.shape)
+    phi = 2 * math.pi / lam * math.sqrt(2 * math.pi) * sigma * delta * np.exp(-(X**2 + Y**2) / (2 * sigma**2))
+    assert 1.0 < phi.max() < math.pi  # phase recoverable from the intensity
+    measured = np.arccos(np.clip(2.0 * img - 1.0, -1.0, 1.0))
+    # The command line's bench (two-cell leapfrog steps, octree skipping)
+    # gets the phase within 5 % of the oracle (measured: 1–4 %, largest
+    # at r ≈ 1.5σ); a wrong wavelength, path or reference index would be
+    # off by far more.
+    # (Where the phase is small the arccos amplifies intensity round-off.)
+    big = phi > 0.5
+    assert np.abs(measured / phi - 1.0)[big].max() < 0.05
+    assert np.abs(img - 0.5 * (1.0 + np.cos(phi))).max() < 0.03
+
+
+def test_color_schlieren_is_white_where_nothing_deflects(gaussian):
+    vol, _, _ = gaussian
+    img = rtvis.color_schlieren(vol, size=48)
+    assert img.shape == (48, 48, 3)
+    np.testing.assert_allclose(img[0, 0], [1.0, 1.0, 1.0], atol=1e-6)
+    # Deflected pixels are coloured (channels differ).
+    assert (img.max(axis=2) - img.min(axis=2)).max() > 0.2
+
+
+def test_same_seed_same_image_and_float64_agrees(gaussian):
+    vol, _, _ = gaussian
+    a = rtvis.schlieren(vol, size=48, seed=7, estimator="photons", photons=4)
+    b = rtvis.schlieren(vol, size=48, seed=7, estimator="photons", photons=4)
+    c = rtvis.schlieren(vol, size=48, seed=8, estimator="photons", photons=4)
+    assert np.array_equal(a, b) and not np.array_equal(a, c)
+    d = rtvis.schlieren(vol, size=48, seed=7, estimator="photons", photons=4, dtype=np.float64)
+    assert d.dtype == np.float64 and np.array_equal(d.astype(np.float32), a)
+
+
+@pytest.mark.parametrize("cutoff,extra,color", [
+    ("knife", ["--angle", "30"], False),
+    ("none", ["--film-distance", "3"], False),
+    ("color", [], True),
+])
+def test_equals_the_rt_command_bit_for_bit(tmp_path, cutoff, extra, color):
+    """The same volume through `rt schlieren --raw16` (which writes
+    round(32768 × I/I0) of the film's float64 values): every pixel equal."""
+    rt = rt_binary()
+    if rt is None:
+        pytest.skip("no `rt` binary (cargo build --release -p rt-cli, or set RT_BIN)")
+    n, h = 40, 1e-3
+    c = 0.5 * (n - 1) * h
+    z, y, x = np.mgrid[0:n, 0:n, 0:n] * h - c
+    rho = (1.2 + 0.4 * np.exp(-((x - 3e-3) ** 2 + y**2 + z**2) / (2 * 6e-3**2))).astype(np.float32)
+    rho.tofile(tmp_path / "v.raw")
+    (tmp_path / "v.json").write_text(json.dumps(
+        {"dims": [n, n, n], "dtype": "float32", "spacing": [h] * 3, "origin": [-c] * 3, "file": "v.raw"}))
+    out = tmp_path / "s.png"
+    subprocess.run([rt, "schlieren", str(tmp_path / "v.json"), "--cutoff", cutoff, "--size", "64",
+                    "--photons", "16", "--seed", "5", "--raw16", "--no-figure", "--out", str(out), *extra],
+                   check=True, capture_output=True)
+    png = read_png16(tmp_path / "s-16bit.png")
+    vol = rtvis.Volume(rho, spacing=(h,) * 3, origin=(-c,) * 3)
+    kw = dict(size=64, photons=16, seed=5, dtype=np.float64)
+    if cutoff == "knife":
+        img = rtvis.schlieren(vol, cutoff="knife", angle=30.0, **kw) * 0.5  # background passes half
+    elif cutoff == "none":
+        img = rtvis.shadowgraph(vol, distance=3.0, **kw)
+    else:
+        # The public result is divided by the filter's own colour at zero
+        # deflection (not exactly white: a 256-pixel hue wheel); compare
+        # the film itself.
+        kw.pop("dtype")
+        img = rtvis._bench(vol, "color", **kw)[0]
+
+    def to16(v):
+        return np.where(v > 0.0, np.minimum(np.floor(v * 32768.0 + 0.5), 65535.0), 0.0).astype(np.int64)
+
+    if color:
+        mine = to16(img)
+    else:
+        mine = to16((img + img + img) / 3.0)
+    assert png.shape == mine.shape
+    assert np.array_equal(png, mine), f"{np.count_nonzero(png != mine)} pixels differ"
+    assert len(np.unique(png)) > 20  # a real image, not a flat one
+
+
+def test_read_volume_reads_what_rt_reads(tmp_path):
+    n = 8
+    data = np.linspace(1.0, 2.0, n**3, dtype=np.float32).reshape(n, n, n)
+    data.tofile(tmp_path / "v.raw")
+    (tmp_path / "v.json").write_text(json.dumps(
+        {"dims": [n, n, n], "dtype": "float32", "spacing": [0.5, 1.0, 2.0], "origin": [1.0, 2.0, 3.0], "file": "v.raw"}))
+    vol = rtvis.read_volume(tmp_path / "v.json", quantity="index")
+    assert vol.shape == (n, n, n)
+    assert vol.spacing == (0.5, 1.0, 2.0) and vol.origin == (1.0, 2.0, 3.0)
+    assert np.array_equal(vol.index(), data)
+    # Density is mapped by Gladstone–Dale.
+    d = rtvis.read_volume(tmp_path / "v.json", k=1e-3)
+    # (rounded to float32 once, from float64: within one float32 step)
+    np.testing.assert_allclose(d.index(), 1.0 + 1e-3 * data.astype(np.float64), rtol=6e-8)
