@@ -146,7 +146,7 @@ impl PyScene {
         Self::default()
     }
 
-    #[pyo3(signature = (points, triangles, scalars, color, colormap, range, material, smooth))]
+    #[pyo3(signature = (points, triangles, scalars, color, colormap, range, material, smooth, normals))]
     #[allow(clippy::too_many_arguments)]
     fn add_mesh(
         &mut self,
@@ -158,6 +158,7 @@ impl PyScene {
         range: Option<(f32, f32)>,
         material: [f32; 5],
         smooth: bool,
+        normals: Option<PyReadonlyArray2<'_, f32>>,
     ) -> PyResult<()> {
         let pts = read_points("points", &points)?;
         let t = triangles.as_array();
@@ -181,7 +182,10 @@ impl PyScene {
         let paint = paint_spec(color, colormap, range, s.as_deref())?;
         let mat = make_material(material)?;
         let mut mesh = Mesh::new(pts, tris, s).map_err(|e| value_error(format!("mesh: {e}")))?;
-        if smooth {
+        if let Some(n) = normals {
+            let n = read_points("normals", &n)?;
+            mesh = mesh.with_normals(n).map_err(|e| value_error(format!("normals: {e}")))?;
+        } else if smooth {
             mesh = mesh.with_smooth_normals();
         }
         self.objects.push(Object::Mesh(mesh, paint, mat));

@@ -22,7 +22,9 @@ NaN, out of range, unknown option), never crashes the interpreter.
 from __future__ import annotations
 
 import math
+import struct
 import time
+import zlib
 from typing import Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -40,7 +42,9 @@ __all__ = [
     "interferogram",
     "read_volume",
     "schlieren",
+    "save_png",
     "shadowgraph",
+    "to_gray8",
     "to_srgb8",
 ]
 
@@ -532,15 +536,21 @@ class Scene:
         self._s = _rtvis._Scene()
 
     def add_mesh(self, points, triangles, scalars=None, color=None, colormap: str = "cool_to_warm",
-                 range=None, material="glossy", smooth: bool = True) -> "Scene":
+                 range=None, material="glossy", smooth: bool = True, normals=None) -> "Scene":
         """Adds a triangle mesh: ``points`` (n, 3), ``triangles`` (m, 3)
         integer indices into the points, ``scalars`` (n,) per point.
-        ``smooth`` interpolates vertex normals (averaged over the faces
-        around each point); otherwise each triangle is flat."""
+        Shading normals: ``normals`` (n, 3) per point if given (e.g. a
+        contour's gradient normals), else with ``smooth`` the face normals
+        averaged around each point, else each triangle flat."""
         p = _array("points", points, 2, np.float32, last=3)
         t = _array("triangles", triangles, 2, None, last=3, integer=True)
         s, c, cm, r = _paint_args(len(p), scalars, color, colormap, range)
-        self._s.add_mesh(p, t, s, c, cm, r, _material(material), bool(smooth))
+        nrm = None
+        if normals is not None:
+            nrm = _array("normals", normals, 2, np.float32, last=3)
+            if len(nrm) != len(p):
+                raise ValueError(f"normals: expected one per point ({len(p)}), got {len(nrm)}")
+        self._s.add_mesh(p, t, s, c, cm, r, _material(material), bool(smooth), nrm)
         return self
 
     def add_spheres(self, centers, radii, scalars=None, color=None, colormap: str = "cool_to_warm",
@@ -764,6 +774,45 @@ def to_srgb8(rgba, background=(1.0, 1.0, 1.0)) -> np.ndarray:
     writer."""
     c = _array("rgba", rgba, 3, np.float32, last=4)
     bg = np.asarray(_vector("background", background), dtype=np.float32)
-    lin = np.clip(c[..., :3] + (1.0 - c[..., 3:4]) * bg, 0.0, 1.0)
+    return _srgb8(c[..., :3] + (1.0 - c[..., 3:4]) * bg)
+
+
+def _srgb8(linear: np.ndarray) -> np.ndarray:
+    lin = np.clip(linear, 0.0, 1.0)
     srgb = np.where(lin <= 0.0031308, 12.92 * lin, 1.055 * np.power(lin, 1 / 2.4) - 0.055)
     return np.round(srgb * 255.0).astype(np.uint8)
+
+
+def to_gray8(image, white: float = 2.0) -> np.ndarray:
+    """An optics image (intensity, 1 = background) as 8-bit sRGB grey
+    ``uint8`` (h, w): ``white`` maps to 255, 0 to 0, linearly in light
+    (so the background of a normalised image, 1 of 2, is mid grey)."""
+    a = _array("image", image, 2, np.float64)
+    return _srgb8(a / _number("white", white, positive=True))
+
+
+def save_png(path, image) -> None:
+    """Writes an 8-bit image, ``uint8`` (h, w) grey, (h, w, 3) RGB or
+    (h, w, 4) RGBA, as a PNG (no other package needed). Convert first:
+    :func:`to_srgb8` for surfaces, :func:`to_gray8` for optics images,
+    ``to_gray8``/``np.clip(... * 255)`` for your own."""
+    import os
+
+    a = np.asarray(image)
+    if a.dtype != np.uint8:
+        raise TypeError(f"image: expected uint8 (convert with to_srgb8 or to_gray8), got dtype {a.dtype}")
+    if a.ndim == 2:
+        a = a[:, :, None]
+    if a.ndim != 3 or a.shape[2] not in (1, 3, 4) or a.shape[0] == 0 or a.shape[1] == 0:
+        raise ValueError(f"image: expected shape (h, w), (h, w, 3) or (h, w, 4), got {np.shape(image)}")
+    h, w, c = a.shape
+    color = {1: 0, 3: 2, 4: 6}[c]
+    rows = np.concatenate([np.zeros((h, 1), dtype=np.uint8), np.ascontiguousarray(a).reshape(h, w * c)], axis=1)
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF)
+
+    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, color, 0, 0, 0))
+           + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6)) + chunk(b"IEND", b""))
+    with open(os.fspath(path), "wb") as f:
+        f.write(png)

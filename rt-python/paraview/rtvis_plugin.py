@@ -1,0 +1,496 @@
+"""ParaView filters backed by rtvis: RT Schlieren and RT Surface Render.
+
+Load with Tools → Manage Plugins → Load New (this file), or put this
+folder on ``PV_PLUGIN_PATH`` to load it at start-up, or from Python::
+
+    import rtvis_pvcompat            # ParaView 5.11 on Python 3.11, see there
+    from paraview.simple import *
+    LoadPlugin("/path/to/rtvis_plugin.py", ns=globals())
+
+``rtvis`` must be importable by ParaView's Python (``pip install`` it for
+that Python, or put the folder it was installed into on ``PYTHONPATH``).
+
+Under MPI (``mpirun -np N pvbatch --symmetric script.py``), RT Surface
+Render renders each rank's own piece and depth-composites the pieces with
+rt-composite over ParaView's MPI world (through mpi4py); the camera and the
+colour-map range are reduced over all ranks, so the image equals the
+one-process render of the whole data. Rank 0's output holds the image, the
+other ranks' outputs are empty.
+"""
+
+import math
+
+import numpy as np
+from paraview.util.vtkAlgorithm import smdomain, smhint, smproperty, smproxy
+from vtkmodules.numpy_interface import dataset_adapter as dsa
+from vtkmodules.util import numpy_support
+from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase
+from vtkmodules.vtkCommonDataModel import vtkDataObject, vtkDataSet, vtkImageData, vtkPolyData
+from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
+from vtkmodules.vtkFiltersCore import vtkTriangleFilter
+from vtkmodules.vtkFiltersGeometry import vtkGeometryFilter
+from vtkmodules.vtkParallelCore import vtkMultiProcessController
+
+_CUTOFFS = ["knife", "graded", "pinhole", "dark-field", "color", "none", "interferometry"]
+_AXES = ["x", "y", "z"]
+_MAPS = ["cool_to_warm", "viridis", "grayscale"]
+
+
+def _enum(name, command, entries, default, doc):
+    items = "".join(f'<Entry value="{i}" text="{t}"/>' for i, t in enumerate(entries))
+    return smproperty.xml(
+        f'<IntVectorProperty name="{name}" command="{command}" number_of_elements="1" '
+        f'default_values="{default}"><EnumerationDomain name="enum">{items}</EnumerationDomain>'
+        f"<Documentation>{doc}</Documentation></IntVectorProperty>"
+    )
+
+
+def _array_selection(name, attribute, doc):
+    return smproperty.xml(
+        f'<StringVectorProperty name="{name}" command="SetInputArrayToProcess" number_of_elements="5" '
+        f'element_types="0 0 0 0 2" animateable="0">'
+        f'<ArrayListDomain name="array_list" attribute_type="{attribute}" input_domain_name="input_array">'
+        f'<RequiredProperties><Property name="Input" function="Input"/></RequiredProperties>'
+        f"</ArrayListDomain><Documentation>{doc}</Documentation></StringVectorProperty>"
+    )
+
+
+def _image_output(out_info, w, h, spacing, origin):
+    out_info.GetInformationObject(0).Set(
+        vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT(), 0, w - 1, 0, h - 1, 0, 0)
+    out_info.GetInformationObject(0).Set(vtkDataObject.SPACING(), spacing[0], spacing[1], 1.0)
+    out_info.GetInformationObject(0).Set(vtkDataObject.ORIGIN(), origin[0], origin[1], 0.0)
+
+
+def _add_array(image, name, values, components):
+    """Adds a (h, w[, c]) numpy image (row 0 at the top) as point data,
+    flipped so row 0 is at the bottom as VTK images have it."""
+    flat = np.ascontiguousarray(values[::-1]).reshape(-1, components) if components > 1 \
+        else np.ascontiguousarray(values[::-1]).reshape(-1)
+    arr = numpy_support.numpy_to_vtk(flat, deep=True)
+    arr.SetName(name)
+    image.GetPointData().AddArray(arr)
+    return arr
+
+
+def _selected_array(algorithm, data):
+    """The array chosen for input array 0 (``SetInputArrayToProcess``;
+    ``GetInputArrayToProcess`` is not wrapped for Python), or None."""
+    info = algorithm.GetInputArrayInformation(0)
+    name = info.Get(vtkDataObject.FIELD_NAME()) if info.Has(vtkDataObject.FIELD_NAME()) else None
+    if not name:
+        return None
+    cells = info.Get(vtkDataObject.FIELD_ASSOCIATION()) == vtkDataObject.FIELD_ASSOCIATION_CELLS
+    return (data.GetCellData() if cells else data.GetPointData()).GetArray(name)
+
+
+def _world():
+    """(rank, size, mpi4py communicator or None) of ParaView's processes."""
+    ctrl = vtkMultiProcessController.GetGlobalController()
+    if ctrl is None or ctrl.GetNumberOfProcesses() < 2:
+        return 0, 1, None
+    from mpi4py import MPI
+
+    comm = MPI.COMM_WORLD
+    return comm.Get_rank(), comm.Get_size(), comm
+
+
+@smproxy.filter(name="RTSchlieren")
+@smhint.xml('<ShowInMenu category="rt"/>')
+@smproperty.input(name="Input", port_index=0)
+@smdomain.datatype(dataTypes=["vtkImageData"], composite_data_supported=False)
+@smdomain.xml('<InputArrayDomain name="input_array" number_of_components="1"/>')
+class RTSchlieren(VTKPythonAlgorithmBase):
+    """Synthetic schlieren, shadowgraph, interferogram or colour schlieren
+    of a volume (density or refractive index) by rtvis: photons traced
+    along curved paths through the field. Output: a 2-D image with
+    ``Intensity`` (1 = undisturbed background; ``RGB`` for the colour
+    filter) and ``Deflection`` (radians, along the image's axes)."""
+
+    def __init__(self):
+        VTKPythonAlgorithmBase.__init__(self, nInputPorts=1, nOutputPorts=1, outputType="vtkImageData")
+        self._quantity, self._k, self._cutoff, self._angle = 0, 2.26e-4, 0, 0.0
+        self._f, self._h, self._film, self._wavelength, self._fringes = 1.0, 0.0, 0.0, 10.6e-6, 0.0
+        self._axis, self._size, self._photons, self._seed, self._cubic = 2, 512, 16, 1, 0
+
+    def _set(self, name, value):
+        if getattr(self, name) != value:
+            setattr(self, name, value)
+            self.Modified()
+
+    @_array_selection("Array", "Scalars", "The volume's scalar: density (kg/m³) or refractive index.")
+    def SetInputArrayToProcess(self, idx, port, connection, field, name):
+        return VTKPythonAlgorithmBase.SetInputArrayToProcess(self, idx, port, connection, field, name)
+
+    @_enum("Quantity", "SetQuantity", ["Density (Gladstone-Dale)", "Refractive index"], 0,
+           "What the array holds; density is mapped by n = 1 + K·ρ.")
+    def SetQuantity(self, v):
+        self._set("_quantity", int(v))
+
+    @smproperty.doublevector(name="K", default_values=[2.26e-4])
+    @smdomain.doublerange(min=0.0)
+    def SetK(self, v):
+        self._set("_k", float(v))
+
+    @_enum("Cutoff", "SetCutoff", ["Knife edge", "Graded filter", "Pinhole", "Dark field", "Colour (hue wheel)",
+                                   "None (shadowgraph)", "Interferometry"], 0, "The optical set-up.")
+    def SetCutoff(self, v):
+        self._set("_cutoff", int(v))
+
+    @smproperty.doublevector(name="Angle", default_values=[0.0])
+    def SetAngle(self, v):
+        self._set("_angle", float(v))
+
+    @smproperty.doublevector(name="FocalLength", default_values=[1.0])
+    def SetFocalLength(self, v):
+        self._set("_f", float(v))
+
+    @smproperty.doublevector(name="SourceHeight", default_values=[0.0])
+    def SetSourceHeight(self, v):
+        self._set("_h", float(v))
+
+    @smproperty.doublevector(name="FilmDistance",
+                             default_values=[0.0])
+    def SetFilmDistance(self, v):
+        self._set("_film", float(v))
+
+    @smproperty.doublevector(name="Wavelength", default_values=[10.6e-6])
+    def SetWavelength(self, v):
+        self._set("_wavelength", float(v))
+
+    @smproperty.doublevector(name="FringeSpacing",
+                             default_values=[0.0])
+    def SetFringeSpacing(self, v):
+        self._set("_fringes", float(v))
+
+    @_enum("Axis", "SetAxis", ["x", "y", "z"], 2, "Beam direction.")
+    def SetAxis(self, v):
+        self._set("_axis", int(v))
+
+    @smproperty.intvector(name="Size", default_values=[512])
+    @smdomain.intrange(min=1, max=16384)
+    def SetSize(self, v):
+        self._set("_size", int(v))
+
+    @smproperty.intvector(name="Photons", default_values=[16])
+    @smdomain.intrange(min=1, max=65536)
+    def SetPhotons(self, v):
+        self._set("_photons", int(v))
+
+    @smproperty.intvector(name="Seed", default_values=[1])
+    def SetSeed(self, v):
+        self._set("_seed", int(v))
+
+    @_enum("Interpolation", "SetInterpolation", ["Trilinear", "Catmull-Rom cubic"], 0,
+           "Interpolation between samples.")
+    def SetInterpolation(self, v):
+        self._set("_cubic", int(v))
+
+    def _geometry(self, in_info):
+        """(dims, origin, spacing) of the samples: points, or cell centres
+        for cell data; and the image's (w, h, pixel size, origin)."""
+        info = in_info[0].GetInformationObject(0)
+        ext = info.Get(vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT())
+        spacing = np.array(info.Get(vtkDataObject.SPACING()), dtype=np.float64)
+        origin = np.array(info.Get(vtkDataObject.ORIGIN()), dtype=np.float64)
+        dims = np.array([ext[1] - ext[0] + 1, ext[3] - ext[2] + 1, ext[5] - ext[4] + 1])
+        origin = origin + spacing * np.array([ext[0], ext[2], ext[4]])
+        arr_info = self.GetInputArrayInformation(0)
+        if arr_info.Get(vtkDataObject.FIELD_ASSOCIATION()) == vtkDataObject.FIELD_ASSOCIATION_CELLS:
+            dims = np.maximum(dims - 1, 1)
+            origin = origin + 0.5 * spacing
+        lo, hi = origin - 0.5 * spacing, origin + (dims - 0.5) * spacing  # as rt's Grid::bounds
+        u, v = {0: (1, 2), 1: (2, 0), 2: (0, 1)}[self._axis]
+        width, height = hi[u] - lo[u], hi[v] - lo[v]
+        w = self._size
+        h = max(1, int(math.floor(w * height / width + 0.5)))
+        px = (width / w, height / h)
+        return dims, origin, spacing, (w, h, px, (lo[u] + 0.5 * px[0], lo[v] + 0.5 * px[1]))
+
+    def RequestInformation(self, request, in_info, out_info):
+        *_, (w, h, px, o) = self._geometry(in_info)
+        _image_output(out_info, w, h, px, o)
+        return 1
+
+    def RequestUpdateExtent(self, request, in_info, out_info):
+        # The whole volume, whatever part of the image is asked for.
+        info = in_info[0].GetInformationObject(0)
+        info.Set(vtkStreamingDemandDrivenPipeline.UPDATE_EXTENT(),
+                 info.Get(vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT()), 6)
+        return 1
+
+    def RequestData(self, request, in_info, out_info):
+        import rtvis
+
+        dims, origin, spacing, (w, h, px, o) = self._geometry(in_info)
+        array = _selected_array(self, vtkImageData.GetData(in_info[0], 0))
+        if array is None:
+            raise ValueError("RT Schlieren: choose a scalar array (Array)")
+        values = numpy_support.vtk_to_numpy(array).reshape(dims[2], dims[1], dims[0])
+        vol = rtvis.Volume(values, spacing=tuple(spacing), origin=tuple(origin),
+                           quantity=["density", "index"][self._quantity], k=self._k,
+                           interpolation=["linear", "cubic"][self._cubic])
+        cutoff = _CUTOFFS[self._cutoff]
+        common = dict(axis=_AXES[self._axis], size=self._size, photons=self._photons, seed=self._seed,
+                      deflection=True)
+        if cutoff == "none":
+            img, eps = rtvis.shadowgraph(vol, distance=self._film or None, **common)
+        elif cutoff == "interferometry":
+            img, eps = rtvis.interferogram(vol, wavelength=self._wavelength,
+                                           fringe_spacing=self._fringes or None, **common)
+        else:
+            img, eps = rtvis.schlieren(vol, cutoff=cutoff, angle=self._angle, f=self._f,
+                                       h=self._h or None, film_distance=self._film, **common)
+        out = vtkImageData.GetData(out_info)
+        out.SetExtent(0, w - 1, 0, h - 1, 0, 0)
+        out.SetSpacing(px[0], px[1], 1.0)
+        out.SetOrigin(o[0], o[1], 0.0)
+        if img.shape[:2] != (h, w):
+            raise RuntimeError(f"RT Schlieren: image {img.shape[:2]} differs from the announced {(h, w)}")
+        main = _add_array(out, "RGB" if img.ndim == 3 else "Intensity", img, img.shape[2] if img.ndim == 3 else 1)
+        _add_array(out, "Deflection", eps, 2)
+        out.GetPointData().SetScalars(main)
+        return 1
+
+
+@smproxy.filter(name="RTSurfaceRender")
+@smhint.xml('<ShowInMenu category="rt"/>')
+@smproperty.input(name="Input", port_index=0)
+@smdomain.datatype(dataTypes=["vtkDataSet"], composite_data_supported=False)
+@smdomain.xml('<InputArrayDomain name="input_array" attribute_type="point" number_of_components="1"/>')
+class RTSurfaceRender(VTKPythonAlgorithmBase):
+    """Ray-traces the input's surface by rtvis: polygons as triangles
+    (coloured by a point array through a colour map), lines as tubes,
+    vertices as spheres; with ambient occlusion and shadows. Output: an
+    image with ``RGB`` (8-bit sRGB over white, for display), ``RGBA``
+    (linear premultiplied float) and ``Depth`` (inf = background). Under
+    MPI each rank renders its piece and the pieces are depth-composited."""
+
+    def __init__(self):
+        VTKPythonAlgorithmBase.__init__(self, nInputPorts=1, nOutputPorts=1, outputType="vtkImageData")
+        self._colored, self._map, self._color = 1, 0, (0.8, 0.8, 0.8)
+        self._custom_range, self._range = 0, (0.0, 1.0)
+        self._size = (512, 512)
+        self._direction, self._up, self._angle = (0.0, 0.0, 1.0), (0.0, 1.0, 0.0), 30.0
+        self._ao, self._ao_distance, self._shadows, self._passes, self._seed = 0, 0.0, 1, 1, 0
+        self._normals, self._sphere_radius, self._tube_radius = 0, 0.0, 0.0
+
+    def _set(self, name, value):
+        if getattr(self, name) != value:
+            setattr(self, name, value)
+            self.Modified()
+
+    @_array_selection("ColorArray", "Scalars", "Point array to colour by.")
+    def SetInputArrayToProcess(self, idx, port, connection, field, name):
+        return VTKPythonAlgorithmBase.SetInputArrayToProcess(self, idx, port, connection, field, name)
+
+    @smproperty.intvector(name="ColorByArray", default_values=[1])
+    @smdomain.xml('<BooleanDomain name="bool"/>')
+    def SetColorByArray(self, v):
+        self._set("_colored", int(v))
+
+    @_enum("ColorMap", "SetColorMap", ["Cool to Warm", "Viridis", "Grayscale"], 0, "Colour map.")
+    def SetColorMap(self, v):
+        self._set("_map", int(v))
+
+    @smproperty.doublevector(name="SolidColor", default_values=[0.8, 0.8, 0.8])
+    def SetSolidColor(self, r, g, b):
+        self._set("_color", (float(r), float(g), float(b)))
+
+    @smproperty.intvector(name="UseCustomRange", default_values=[0])
+    @smdomain.xml('<BooleanDomain name="bool"/>')
+    def SetUseCustomRange(self, v):
+        self._set("_custom_range", int(v))
+
+    @smproperty.doublevector(name="Range", default_values=[0.0, 1.0])
+    def SetRange(self, lo, hi):
+        self._set("_range", (float(lo), float(hi)))
+
+    @smproperty.intvector(name="ImageSize", default_values=[512, 512])
+    def SetImageSize(self, w, h):
+        self._set("_size", (int(w), int(h)))
+
+    @smproperty.doublevector(name="ViewDirection",
+                             default_values=[0.0, 0.0, 1.0])
+    def SetViewDirection(self, x, y, z):
+        self._set("_direction", (float(x), float(y), float(z)))
+
+    @smproperty.doublevector(name="ViewUp", default_values=[0.0, 1.0, 0.0])
+    def SetViewUp(self, x, y, z):
+        self._set("_up", (float(x), float(y), float(z)))
+
+    @smproperty.doublevector(name="ViewAngle", default_values=[30.0])
+    def SetViewAngle(self, v):
+        self._set("_angle", float(v))
+
+    @smproperty.intvector(name="AOSamples", default_values=[0])
+    @smdomain.intrange(min=0, max=64)
+    def SetAOSamples(self, v):
+        self._set("_ao", int(v))
+
+    @smproperty.doublevector(name="AODistance",
+                             default_values=[0.0])
+    def SetAODistance(self, v):
+        self._set("_ao_distance", float(v))
+
+    @smproperty.intvector(name="Shadows", default_values=[1])
+    @smdomain.xml('<BooleanDomain name="bool"/>')
+    def SetShadows(self, v):
+        self._set("_shadows", int(v))
+
+    @smproperty.intvector(name="Passes", default_values=[1])
+    @smdomain.intrange(min=1, max=256)
+    def SetPasses(self, v):
+        self._set("_passes", int(v))
+
+    @smproperty.intvector(name="Seed", default_values=[0])
+    def SetSeed(self, v):
+        self._set("_seed", int(v))
+
+    @_enum("Normals", "SetNormals", ["Data's Normals array, else smooth", "Smooth (averaged)", "Flat"], 0,
+           "Shading normals. Flat shading is the same whichever rank holds a triangle's neighbours.")
+    def SetNormals(self, v):
+        self._set("_normals", int(v))
+
+    @smproperty.doublevector(name="SphereRadius",
+                             default_values=[0.0])
+    def SetSphereRadius(self, v):
+        self._set("_sphere_radius", float(v))
+
+    @smproperty.doublevector(name="TubeRadius",
+                             default_values=[0.0])
+    def SetTubeRadius(self, v):
+        self._set("_tube_radius", float(v))
+
+    def FillInputPortInformation(self, port, info):
+        info.Set(self.INPUT_REQUIRED_DATA_TYPE(), "vtkDataSet")
+        return 1
+
+    def RequestInformation(self, request, in_info, out_info):
+        w, h = self._size
+        _image_output(out_info, w, h, (1.0, 1.0), (0.0, 0.0))
+        return 1
+
+    def RequestUpdateExtent(self, request, in_info, out_info):
+        # This process's piece of the input, whatever part of the image is
+        # asked for (the image is whole on rank 0).
+        ctrl = vtkMultiProcessController.GetGlobalController()
+        rank, size = (ctrl.GetLocalProcessId(), ctrl.GetNumberOfProcesses()) if ctrl else (0, 1)
+        info = in_info[0].GetInformationObject(0)
+        sddp = vtkStreamingDemandDrivenPipeline
+        info.Set(sddp.UPDATE_PIECE_NUMBER(), rank)
+        info.Set(sddp.UPDATE_NUMBER_OF_PIECES(), size)
+        info.Set(sddp.UPDATE_NUMBER_OF_GHOST_LEVELS(), 0)
+        if info.Has(sddp.UPDATE_EXTENT()):
+            info.Remove(sddp.UPDATE_EXTENT())
+        return 1
+
+    def _surface(self, in_info):
+        data = vtkDataSet.GetData(in_info[0], 0)
+        if not isinstance(data, vtkPolyData):
+            g = vtkGeometryFilter()
+            g.SetInputData(data)
+            g.Update()
+            data = g.GetOutput()
+        return data
+
+    def RequestData(self, request, in_info, out_info):
+        import rtvis
+
+        rank, size, comm = _world()
+        poly = self._surface(in_info)
+        points = numpy_support.vtk_to_numpy(poly.GetPoints().GetData()) if poly.GetNumberOfPoints() else np.zeros((0, 3))
+        scalars = None
+        if self._colored:
+            array = _selected_array(self, vtkDataSet.GetData(in_info[0], 0))
+            if array is not None:
+                name = array.GetName()
+                pa = poly.GetPointData().GetArray(name) if name else None
+                if pa is not None:
+                    scalars = numpy_support.vtk_to_numpy(pa).astype(np.float64)
+                    if scalars.ndim == 2:
+                        scalars = np.linalg.norm(scalars, axis=1)
+        # Bounds and scalar range over every rank (a rank may hold nothing).
+        lo = points.min(axis=0) if len(points) else np.full(3, np.inf)
+        hi = points.max(axis=0) if len(points) else np.full(3, -np.inf)
+        finite = scalars[np.isfinite(scalars)] if scalars is not None else np.zeros(0)
+        srange = np.array([finite.min(), finite.max()]) if len(finite) else np.array([np.inf, -np.inf])
+        if comm is not None:
+            from mpi4py import MPI
+
+            # One reduction each, on every rank, before anything can raise.
+            mins = np.ascontiguousarray(np.concatenate([lo, srange[:1]]), dtype=np.float64)
+            maxs = np.ascontiguousarray(np.concatenate([hi, srange[1:]]), dtype=np.float64)
+            comm.Allreduce(MPI.IN_PLACE, mins, op=MPI.MIN)
+            comm.Allreduce(MPI.IN_PLACE, maxs, op=MPI.MAX)
+            lo, hi, srange = mins[:3], maxs[:3], np.array([mins[3], maxs[3]])
+        w, h = self._size
+        out = vtkImageData.GetData(out_info)
+        if not np.all(lo <= hi):
+            raise ValueError("RT Surface Render: the input has no points on any rank")
+        diag = float(np.linalg.norm(hi - lo)) or 1.0
+        if self._custom_range:
+            rng = self._range
+        elif srange[0] < srange[1]:
+            rng = (float(srange[0]), float(srange[1]))
+        elif np.isfinite(srange[0]):
+            rng = (float(srange[0]) - 0.5, float(srange[0]) + 0.5)
+        else:
+            rng = (0.0, 1.0)
+        paint = dict(scalars=None, color=self._color) if scalars is None else \
+            dict(scalars=scalars, colormap=_MAPS[self._map], range=rng)
+
+        scene = rtvis.Scene()
+        tri = vtkTriangleFilter()
+        tri.SetInputData(poly)
+        tri.PassVertsOff()
+        tri.PassLinesOff()
+        tri.Update()
+        polys = tri.GetOutput().GetPolys()
+        if polys.GetNumberOfCells():
+            t = numpy_support.vtk_to_numpy(polys.GetConnectivityArray()).reshape(-1, 3)
+            normals = poly.GetPointData().GetNormals()
+            smooth = self._normals != 2
+            mesh_paint = dict(paint)
+            if scalars is not None:
+                mesh_paint["scalars"] = scalars
+            scene.add_mesh(points, t, smooth=smooth and (normals is None or self._normals == 1),
+                           normals=numpy_support.vtk_to_numpy(normals) if (normals is not None and self._normals == 0) else None,
+                           **mesh_paint)
+        lines = poly.GetLines()
+        if lines.GetNumberOfCells():
+            off = numpy_support.vtk_to_numpy(lines.GetOffsetsArray())
+            con = numpy_support.vtk_to_numpy(lines.GetConnectivityArray())
+            radius = self._tube_radius or 0.002 * diag
+            for a, b in zip(off[:-1], off[1:]):
+                ids = con[a:b]
+                if len(ids) >= 2:
+                    scene.add_tubes(points[ids], radius, **({**paint, "scalars": scalars[ids]} if scalars is not None else paint))
+        verts = poly.GetVerts()
+        if verts.GetNumberOfCells():
+            ids = numpy_support.vtk_to_numpy(verts.GetConnectivityArray())
+            radius = self._sphere_radius or 0.005 * diag
+            scene.add_spheres(points[ids], radius, **({**paint, "scalars": scalars[ids]} if scalars is not None else paint))
+
+        camera = rtvis.Camera.fit((tuple(lo), tuple(hi)), direction=self._direction, up=self._up,
+                                  fov=self._angle, aspect=w / h)
+        if len(scene):
+            rgba, depth = scene.render(camera, size=(w, h), ao=self._ao,
+                                       ao_distance=self._ao_distance or 0.1 * diag,
+                                       shadows=bool(self._shadows), passes=self._passes, seed=self._seed)
+        else:  # this rank's piece is empty: it still takes part in compositing
+            rgba, depth = np.zeros((h, w, 4), np.float32), np.full((h, w), np.inf, np.float32)
+        if comm is not None:
+            result = rtvis.composite_mpi(rgba, depth, comm=comm)
+            if result is None:
+                out.SetExtent(0, -1, 0, -1, 0, -1)
+                return 1
+            rgba, depth = result
+        out.SetExtent(0, w - 1, 0, h - 1, 0, 0)
+        out.SetSpacing(1.0, 1.0, 1.0)
+        out.SetOrigin(0.0, 0.0, 0.0)
+        rgb = _add_array(out, "RGB", rtvis.to_srgb8(rgba), 3)
+        _add_array(out, "RGBA", rgba, 4)
+        _add_array(out, "Depth", depth, 1)
+        out.GetPointData().SetScalars(rgb)
+        return 1

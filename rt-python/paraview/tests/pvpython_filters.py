@@ -1,0 +1,78 @@
+"""pvpython test of both filters (run by run-tests.sh): the plugin loads on
+a stock ParaView 5.11 + Python 3.11 (through rtvis_pvcompat), RT Schlieren
+turns a vtkImageData of density into the same image rtvis makes from the
+same samples, and RT Surface Render draws a contour.
+
+    pvpython pvpython_filters.py OUT_DIR
+"""
+
+import os
+import sys
+
+import rtvis_pvcompat  # noqa: F401  (before anything imports paraview.detail.pythonalgorithm)
+
+import numpy as np
+from paraview.simple import LoadPlugin, Contour, Wavelet, Calculator
+from vtkmodules.util import numpy_support
+
+import rtvis
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+out_dir = sys.argv[1]
+os.makedirs(out_dir, exist_ok=True)
+LoadPlugin(os.path.join(HERE, "..", "rtvis_plugin.py"), ns=globals())
+
+
+def arrays(proxy):
+    proxy.UpdatePipeline()
+    data = proxy.GetClientSideObject().GetOutputDataObject(0)
+    ext = data.GetExtent()
+    w, h = ext[1] - ext[0] + 1, ext[3] - ext[2] + 1
+    pd = data.GetPointData()
+    got = {}
+    for i in range(pd.GetNumberOfArrays()):
+        a = numpy_support.vtk_to_numpy(pd.GetArray(i))
+        a = a.reshape((h, w) + a.shape[1:])[::-1]  # row 0 at the top again
+        got[pd.GetArrayName(i)] = a
+    return got
+
+
+# A Gaussian density bump as vtkImageData (a Wavelet's grid, its RTData
+# replaced by a Calculator expression): 48³ points, 1 mm apart.
+src = Wavelet(WholeExtent=[-24, 23, -24, 23, -24, 23])
+bump = Calculator(Input=src, ResultArrayName="density",
+                  Function="1.2 + 0.3*exp(-((coordsX*0.001)^2+(coordsY*0.001)^2+(coordsZ*0.001)^2)/(2*0.008^2))")
+bump.UpdatePipeline()
+image = bump.GetClientSideObject().GetOutputDataObject(0)
+rho = numpy_support.vtk_to_numpy(image.GetPointData().GetArray("density")).reshape(48, 48, 48)
+
+knife = RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=0, Size=96, Photons=16, Seed=3)
+# The Wavelet's own spacing is 1 (unit): the bump is in those units too.
+got = arrays(knife)
+vol = rtvis.Volume(rho, spacing=(1.0, 1.0, 1.0), origin=(-24.0, -24.0, -24.0))
+mine = rtvis.schlieren(vol, cutoff="knife", size=96, photons=16, seed=3)
+assert got["Intensity"].shape == mine.shape, (got["Intensity"].shape, mine.shape)
+assert np.array_equal(got["Intensity"], mine), "RT Schlieren differs from rtvis.schlieren"
+assert got["Deflection"].shape == mine.shape + (2,)
+assert mine.min() < 0.8 and mine.max() > 1.2, (mine.min(), mine.max())
+rtvis.save_png(os.path.join(out_dir, "paraview-schlieren.png"), rtvis.to_gray8(got["Intensity"]))
+print(f"RT Schlieren: {mine.shape[1]}×{mine.shape[0]}, equal to rtvis.schlieren; wrote paraview-schlieren.png")
+
+color = RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=4, Size=64)
+assert arrays(color)["RGB"].shape == (64, 64, 3)
+shadow = RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=5, Size=64)
+assert arrays(shadow)["Intensity"].std() > 0.01
+print("RT Schlieren colour and shadowgraph: ok")
+
+contour = Contour(Input=Wavelet(), ContourBy=["POINTS", "RTData"], Isosurfaces=[130.0, 200.0])
+elev = Calculator(Input=contour, ResultArrayName="height", Function="coordsY")
+surface = RTSurfaceRender(Input=elev, ColorArray=["POINTS", "height"], ImageSize=[320, 240],
+                          AOSamples=4, Shadows=1, ViewDirection=[1.0, 0.8, 1.6])
+img = arrays(surface)
+assert img["RGBA"].shape == (240, 320, 4) and img["Depth"].shape == (240, 320)
+hit = np.isfinite(img["Depth"])
+assert 0.1 < hit.mean() < 0.9, hit.mean()
+assert np.all(img["RGBA"][~hit] == 0.0) and np.all(img["RGBA"][hit, 3] > 0.99)
+rtvis.save_png(os.path.join(out_dir, "paraview-surface.png"), img["RGB"].astype(np.uint8))
+print(f"RT Surface Render: 320×240, {hit.mean():.0%} of pixels hit; wrote paraview-surface.png")
+print("pvpython: both filters ok")
