@@ -293,6 +293,7 @@ impl Bench {
         let fb = (p - self.center).dot(v);
         let fx = (fa / self.width + 0.5) * w as f64;
         let fy = (0.5 - fb / self.height) * h as f64;
+        let mut phase = 0.0;
         let weight = match &self.mode {
             Mode::Schlieren(_) => {
                 let t = cutoff.map_or([1.0; 3], |p| p.transmit(eu, ev));
@@ -307,12 +308,13 @@ impl Bench {
             Mode::Interferometry { lambda, n_ref, fringe_spacing } => {
                 let straight = (r.position - o).dot(self.direction);
                 let phi = core::f64::consts::TAU / lambda * (r.optical_path - n_ref * straight);
+                phase = phi;
                 let carrier = fringe_spacing.map_or(0.0, |s| core::f64::consts::TAU * fa / s);
                 [(0.5 * (1.0 + math::cos(phi + carrier))) as f32; 3]
             }
         };
         let weight = [weight[0] * colour[0], weight[1] * colour[1], weight[2] * colour[2]];
-        Ok(Photon::new(fx, fy, weight, (eu, ev)))
+        Ok(Photon::new(fx, fy, weight, (eu, ev)).with_phase(phase))
     }
 
     /// The cutoff, prepared, for schlieren.

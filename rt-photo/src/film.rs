@@ -51,6 +51,10 @@ pub struct Photon {
     /// the angles for small deflections. Averaged per pixel by
     /// [`Film::mean_deflection`].
     pub deflection: (f64, f64),
+    /// Interferometry: the photon's phase `φ = (2π/λ)·∫(n − n_ref) ds`
+    /// in radians, unwrapped (0 in the other modes). Averaged per pixel by
+    /// [`Film::mean_phase`].
+    pub phase: f64,
 }
 
 impl Photon {
@@ -59,7 +63,14 @@ impl Photon {
     #[inline]
     #[must_use]
     pub const fn new(x: f64, y: f64, weight: [f32; 3], deflection: (f64, f64)) -> Self {
-        Self { x, y, weight, deflection }
+        Self { x, y, weight, deflection, phase: 0.0 }
+    }
+
+    /// The photon with its interferometric `phase` (radians).
+    #[inline]
+    #[must_use]
+    pub const fn with_phase(self, phase: f64) -> Self {
+        Self { phase, ..self }
     }
 }
 
@@ -106,15 +117,16 @@ impl fmt::Display for FilmError {
 
 impl core::error::Error for FilmError {}
 
-/// Accumulated photon weight per pixel (RGB), the mean deflection per pixel
-/// (the picking pass), and photon bookkeeping.
+/// Accumulated photon weight per pixel (RGB), the mean deflection and
+/// phase per pixel (the picking pass), and photon bookkeeping.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     width: usize,
     height: usize,
     filter: Filter,
     rgb: Vec<[f64; 3]>,
-    eps: Vec<[f64; 3]>,
+    /// Per pixel: Σ k·εu, Σ k·εv, Σ k, Σ k·φ.
+    eps: Vec<[f64; 4]>,
     /// Photons emitted so far.
     pub emitted: u64,
     /// Photons that landed outside the film (counted, not splatted; for a
@@ -125,8 +137,8 @@ pub struct Film {
 }
 
 impl Film {
-    /// The most pixels a film may have: 2²⁸ (its accumulators take 48
-    /// bytes a pixel, 12 GiB at the limit).
+    /// The most pixels a film may have: 2²⁸ (its accumulators take 56
+    /// bytes a pixel, 14 GiB at the limit).
     pub const MAX_PIXELS: usize = 1 << 28;
 
     /// An empty film of `width × height` pixels.
@@ -154,7 +166,7 @@ impl Film {
             height,
             filter,
             rgb: alloc::vec![[0.0; 3]; n],
-            eps: alloc::vec![[0.0; 3]; n],
+            eps: alloc::vec![[0.0; 4]; n],
             emitted: 0,
             lost: 0,
             per_pixel: 0.0,
@@ -177,6 +189,12 @@ impl Film {
     /// coordinates `(x, y)` (pixel `(i, j)` spans `[i, i+1) × [j, j+1)`),
     /// with its deflection for the picking pass.
     pub fn splat(&mut self, x: f64, y: f64, w: [f32; 3], eps: (f64, f64)) {
+        self.splat_photon(&Photon::new(x, y, w, eps));
+    }
+
+    /// [`Film::splat`] of a whole photon (its phase too).
+    pub fn splat_photon(&mut self, p: &Photon) {
+        let &Photon { x, y, weight: w, deflection: eps, phase } = p;
         if !self.on_film(x, y) {
             self.lost += 1;
             return;
@@ -184,7 +202,8 @@ impl Film {
         let width = self.width;
         let (rgb, eps_acc) = (&mut self.rgb, &mut self.eps);
         footprint(self.filter, self.width, self.height, x, y, |i, j, k| {
-            deposit(&mut rgb[i + width * j], &mut eps_acc[i + width * j], k, w.map(f64::from), eps);
+            let p = i + width * j;
+            deposit(&mut rgb[p], &mut eps_acc[p], k, w.map(f64::from), eps, phase);
         });
     }
 
@@ -193,7 +212,7 @@ impl Film {
     }
 
     /// Splats photons in order: the same image, bit for bit, as calling
-    /// [`Film::splat`] on each in turn. With feature
+    /// [`Film::splat_photon`] on each in turn. With feature
     /// `parallel` the film's rows are split into bands filled in parallel,
     /// each band taking, in order, the photons whose footprint reaches it,
     /// so every pixel still sums its contributions in the serial order.
@@ -213,7 +232,7 @@ impl Film {
             };
             self.bands(|lo, rgb, eps_acc| {
                 let hi = lo + rgb.len() / width;
-                for &Photon { x, y, weight: w, deflection: e } in photons.clone() {
+                for &Photon { x, y, weight: w, deflection: e, phase } in photons.clone() {
                     let on = x >= 0.0 && y >= 0.0 && x < width as f64 && y < height as f64;
                     if !on || y + reach < lo as f64 || y - reach >= hi as f64 {
                         continue;
@@ -221,7 +240,7 @@ impl Film {
                     footprint(filter, width, height, x, y, |i, j, k| {
                         if (lo..hi).contains(&j) {
                             let p = i + width * (j - lo);
-                            deposit(&mut rgb[p], &mut eps_acc[p], k, w.map(f64::from), e);
+                            deposit(&mut rgb[p], &mut eps_acc[p], k, w.map(f64::from), e, phase);
                         }
                     });
                 }
@@ -230,7 +249,7 @@ impl Film {
         }
         #[cfg(not(feature = "parallel"))]
         for p in photons {
-            self.splat(p.x, p.y, p.weight, p.deflection);
+            self.splat_photon(p);
         }
     }
 
@@ -269,7 +288,7 @@ impl Film {
             })
             .collect();
         const CORNER: [(usize, usize); 4] = [(0, 0), (1, 0), (1, 1), (0, 1)];
-        let band = |lo: usize, rgb: &mut [[f64; 3]], eps: &mut [[f64; 3]]| {
+        let band = |lo: usize, rgb: &mut [[f64; 3]], eps: &mut [[f64; 4]]| {
             let hi = lo + rgb.len() / width;
             for (b, rows) in lattice.windows(2).enumerate() {
                 let (y0, y1) = reach[b];
@@ -282,17 +301,18 @@ impl Film {
                     // deflection of `corners` uniformly over `image`.
                     let mut spread = |corners: &[usize], image: &[(f64, f64)], e: f64| {
                         let m = 1.0 / corners.len() as f64;
-                        let (mut w, mut d) = ([0.0; 3], (0.0, 0.0));
+                        let (mut w, mut d, mut phi) = ([0.0; 3], (0.0, 0.0), 0.0);
                         for &i in corners {
                             let p = c[i];
                             for (wc, pc) in w.iter_mut().zip(p.weight) {
                                 *wc += m * f64::from(pc);
                             }
                             d = (d.0 + m * p.deflection.0, d.1 + m * p.deflection.1);
+                            phi += m * p.phase;
                         }
                         sheet::cover(image, width, height, (lo, hi), |i, j, k| {
                             let p = i + width * (j - lo);
-                            deposit(&mut rgb[p], &mut eps[p], k * e, w, d);
+                            deposit(&mut rgb[p], &mut eps[p], k * e, w, d, phi);
                         });
                     };
                     let landed = [0, 1, 2, 3].map(|i| (c[i].x, c[i].y));
@@ -324,7 +344,7 @@ impl Film {
     /// the film: one band per thread, in parallel, with feature `parallel`;
     /// the whole film at once without. A pixel's sums then depend only on
     /// the order `fill` visits its contributions, never on the banding.
-    fn bands(&mut self, fill: impl Fn(usize, &mut [[f64; 3]], &mut [[f64; 3]]) + Sync) {
+    fn bands(&mut self, fill: impl Fn(usize, &mut [[f64; 3]], &mut [[f64; 4]]) + Sync) {
         #[cfg(feature = "parallel")]
         {
             use rayon::prelude::*;
@@ -375,17 +395,34 @@ impl Film {
     pub fn mean_deflection(&self) -> Vec<Option<(f64, f64)>> {
         self.eps.iter().map(|e| (e[2] > 0.0).then(|| (e[0] / e[2], e[1] / e[2]))).collect()
     }
+
+    /// Mean interferometric phase (radians, unwrapped: see
+    /// [`Photon::phase`]) of the photons that landed in each pixel; `None`
+    /// for empty pixels; 0 where the bench is not an interferometer.
+    #[must_use]
+    pub fn mean_phase(&self) -> Vec<Option<f64>> {
+        self.eps.iter().map(|e| (e[2] > 0.0).then(|| e[3] / e[2])).collect()
+    }
 }
 
-/// Adds a photon's share `k` of weight `w` and deflection `eps` to a pixel.
+/// Adds a photon's share `k` of weight `w`, deflection `eps` and `phase`
+/// to a pixel.
 #[inline]
-fn deposit(rgb: &mut [f64; 3], acc: &mut [f64; 3], k: f64, w: [f64; 3], eps: (f64, f64)) {
+fn deposit(
+    rgb: &mut [f64; 3],
+    acc: &mut [f64; 4],
+    k: f64,
+    w: [f64; 3],
+    eps: (f64, f64),
+    phase: f64,
+) {
     for (a, wc) in rgb.iter_mut().zip(w) {
         *a += k * wc;
     }
     acc[0] += k * eps.0;
     acc[1] += k * eps.1;
     acc[2] += k;
+    acc[3] += k * phase;
 }
 
 /// Calls `add(i, j, k)` for every pixel of the filter's footprint around

@@ -13,7 +13,9 @@
 //!
 //! Images are normalised to the background (1 = undisturbed, uncut) and
 //! deterministic: the same seed gives the same image, bit for bit, at any
-//! thread count (feature `parallel`).
+//! thread count (feature `parallel`). Beside the image the film keeps, per
+//! pixel, the photons' mean deflection ([`Film::mean_deflection`]) and,
+//! for interferometry, their mean phase, unwrapped ([`Film::mean_phase`]).
 //!
 //! The `rt-volume` types this crate's API takes are re-exported at the
 //! root ([`IndexField`], [`GridField`], [`Octree`], [`TraceParams`], …),

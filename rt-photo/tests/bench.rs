@@ -115,6 +115,29 @@ fn interferogram_phase_matches_the_analytic_gaussian() {
     };
     assert!(rmse(&film, want) < 0.02, "rmse {}", rmse(&film, want));
     assert!(rmse(&film, |x, y| 0.5 * (1.0 + (want(x, y) * 2.0 - 1.0).acos().sin())) > 0.1);
+    // The mean phase per pixel, unwrapped, is the oracle's φ itself: the
+    // pixel's average of a smooth φ over its area (second order in the
+    // pixel size, 0.16 σ here: ≤ 0.5 % of φ(0)) and first order in δ.
+    let phi0 = core::f64::consts::TAU / lambda * SQRT_2PI * sigma * delta;
+    let phase = film.mean_phase();
+    let mut worst: f64 = 0.0;
+    for j in 0..film.height() {
+        for i in 0..film.width() {
+            let (x, y) = centre(&film, i, j);
+            let got = phase[i + film.width() * j].expect("every pixel gets photons");
+            worst = worst.max((got - phi0 * (-(x * x + y * y) / 2.0).exp()).abs());
+        }
+    }
+    assert!(worst < 5e-3 * phi0, "phase error {worst:e} rad of φ(0) = {phi0}");
+}
+
+/// Outside interferometry the phase is not recorded: 0.
+#[test]
+fn schlieren_films_record_no_phase() {
+    let f = GaussianBump::new(DVec3::ZERO, 1e-4, 1.0, 5.0);
+    let mut film = Film::new(8, 8, Filter::Box).unwrap();
+    bench(knife(1500.0), 2).render(&f, &mut film, 0, 1).unwrap();
+    assert!(film.mean_phase().iter().all(|p| *p == Some(0.0)));
 }
 
 /// Russian roulette has the weighted image's expectation.

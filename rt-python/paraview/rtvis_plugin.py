@@ -105,7 +105,8 @@ class RTSchlieren(VTKPythonAlgorithmBase):
     of a volume (density or refractive index) by rtvis: photons traced
     along curved paths through the field. Output: a 2-D image with
     ``Intensity`` (1 = undisturbed background; ``RGB`` for the colour
-    filter) and ``Deflection`` (radians, along the image's axes)."""
+    filter), ``Deflection`` (radians, along the image's axes) and, for
+    interferometry, ``Phase`` (radians, unwrapped)."""
 
     def __init__(self):
         VTKPythonAlgorithmBase.__init__(self, nInputPorts=1, nOutputPorts=1, outputType="vtkImageData")
@@ -236,8 +237,8 @@ class RTSchlieren(VTKPythonAlgorithmBase):
         if cutoff == "none":
             img, eps = rtvis.shadowgraph(vol, distance=self._film or None, **common)
         elif cutoff == "interferometry":
-            img, eps = rtvis.interferogram(vol, wavelength=self._wavelength,
-                                           fringe_spacing=self._fringes or None, **common)
+            img, eps, phase = rtvis.interferogram(vol, wavelength=self._wavelength,
+                                                  fringe_spacing=self._fringes or None, phase=True, **common)
         else:
             img, eps = rtvis.schlieren(vol, cutoff=cutoff, angle=self._angle, f=self._f,
                                        h=self._h or None, film_distance=self._film, **common)
@@ -249,6 +250,8 @@ class RTSchlieren(VTKPythonAlgorithmBase):
             raise RuntimeError(f"RT Schlieren: image {img.shape[:2]} differs from the announced {(h, w)}")
         main = _add_array(out, "RGB" if img.ndim == 3 else "Intensity", img, img.shape[2] if img.ndim == 3 else 1)
         _add_array(out, "Deflection", eps, 2)
+        if cutoff == "interferometry":
+            _add_array(out, "Phase", phase, 1)
         out.GetPointData().SetScalars(main)
         return 1
 

@@ -6,7 +6,10 @@
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use numpy::{IntoPyArray, PyArray3, ndarray::Array3};
+use numpy::{
+    IntoPyArray, PyArray2, PyArray3,
+    ndarray::{Array2, Array3},
+};
 use pyo3::prelude::*;
 use rt_cli::{
     optics::{Axis, Interpolation, Quantity, Samples},
@@ -42,9 +45,17 @@ fn positive(name: &str, v: f64) -> PyResult<f64> {
 
 /// The film as `(image [h, w, 3] relative to an undisturbed beam with
 /// nothing cut, in the f64 the film accumulates in, mean deflection [h, w, 2] in radians (NaN where no photon
-/// landed), the image of an undisturbed beam through the optics (RGB), a
-/// line saying which optics were chosen)`.
-type Optics<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f32>>, [f32; 3], String);
+/// landed), the mean interferometric phase [h, w] in radians (NaN where
+/// no photon landed; 0 outside interferometry), the image of an
+/// undisturbed beam through the optics (RGB), a line saying which optics
+/// were chosen)`.
+type Optics<'py> = (
+    Bound<'py, PyArray3<f64>>,
+    Bound<'py, PyArray3<f32>>,
+    Bound<'py, PyArray2<f64>>,
+    [f32; 3],
+    String,
+);
 
 /// Renders `volume` on the bench the arguments describe.
 #[pyfunction]
@@ -129,7 +140,15 @@ pub(crate) fn optics<'py>(
         .into_iter()
         .flat_map(|e| e.map_or([f32::NAN; 2], |(u, v)| [u as f32, v as f32]))
         .collect();
+    let phase: Vec<f64> = film.mean_phase().into_iter().map(|p| p.unwrap_or(f64::NAN)).collect();
     let image = Array3::from_shape_vec((h, w, 3), rgb).map_err(value_error)?;
     let deflection = Array3::from_shape_vec((h, w, 2), eps).map_err(value_error)?;
-    Ok((image.into_pyarray(py), deflection.into_pyarray(py), background, chosen))
+    let phase = Array2::from_shape_vec((h, w), phase).map_err(value_error)?;
+    Ok((
+        image.into_pyarray(py),
+        deflection.into_pyarray(py),
+        phase.into_pyarray(py),
+        background,
+        chosen,
+    ))
 }

@@ -62,7 +62,9 @@ color = RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=4, Size=64)
 assert arrays(color)["RGB"].shape == (64, 64, 3)
 shadow = RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=5, Size=64)
 assert arrays(shadow)["Intensity"].std() > 0.01
-print("RT Schlieren colour and shadowgraph: ok")
+fringes = arrays(RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=6, Size=64, Wavelength=1e-6))
+assert fringes["Phase"].shape == (64, 64) and fringes["Phase"].max() > 2 * np.pi
+print("RT Schlieren colour, shadowgraph and interferogram (with its phase): ok")
 
 contour = Contour(Input=Wavelet(), ContourBy=["POINTS", "RTData"], Isosurfaces=[130.0, 200.0])
 elev = Calculator(Input=contour, ResultArrayName="height", Function="coordsY")

@@ -360,7 +360,7 @@ def schlieren(
 
     The same options and seed give the same image as ``rt schlieren``.
     """
-    image, eps, background, _ = _bench(
+    image, eps, _, background, _ = _bench(
         volume, _choice("cutoff", cutoff, _CUTOFFS), angle=angle, f=f, h=h, radius=radius,
         half_range=half_range, film_distance=film_distance, axis=axis, size=size,
         photons=photons, seed=seed, estimator=estimator,
@@ -387,7 +387,7 @@ def shadowgraph(
     behind the volume's mid-plane (default: automatic, the strongest
     contrast about 0.5). Returns the intensity relative to the undisturbed
     beam, (h, w) of ``dtype`` (and the deflection, as :func:`schlieren`)."""
-    image, eps, background, _ = _bench(
+    image, eps, _, background, _ = _bench(
         volume, "none", film_distance=distance, axis=axis, size=size, photons=photons, seed=seed
     )
     out = _grey(image, background, dtype)
@@ -403,20 +403,28 @@ def interferogram(
     photons: int = 16,
     seed: int = 1,
     deflection: bool = False,
+    phase: bool = False,
     dtype=np.float32,
 ):
     """Synthetic interferogram: ``I = (1 + cos(φ + 2π x/Λ))/2`` with the
     phase ``φ = (2π/λ)·∫(n − n_ref) ds`` along each curved path (``n_ref``:
     the first sample's index). ``wavelength`` λ in metres (default: CO₂
     laser, 10.6 µm); ``fringe_spacing`` Λ on the film in metres (default:
-    infinite fringe). Returns (h, w) of ``dtype`` in [0, 1] (and the
-    deflection, as :func:`schlieren`)."""
-    image, eps, background, _ = _bench(
+    infinite fringe). Returns (h, w) of ``dtype`` in [0, 1]; with
+    ``deflection=True`` also the deflection (as :func:`schlieren`); with
+    ``phase=True`` also φ itself, float64 (h, w) in radians, **unwrapped**
+    (each photon's own phase, averaged per pixel; no 2π ambiguity; NaN
+    where no photon landed), last in the tuple."""
+    image, eps, phi, background, _ = _bench(
         volume, "interferometry", wavelength=wavelength, fringe_spacing=fringe_spacing,
         axis=axis, size=size, photons=photons, seed=seed,
     )
-    out = _grey(image, background, dtype)
-    return (out, eps) if deflection else out
+    out = (_grey(image, background, dtype),)
+    if deflection:
+        out += (eps,)
+    if phase:
+        out += (phi,)
+    return out if len(out) > 1 else out[0]
 
 
 def color_schlieren(
