@@ -62,7 +62,7 @@ color = RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=4, Size=64)
 assert arrays(color)["RGB"].shape == (64, 64, 3)
 shadow = RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=5, Size=64)
 assert arrays(shadow)["Intensity"].std() > 0.01
-fringes = arrays(RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=6, Size=64, Wavelength=1e-6))
+fringes = arrays(RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=6, Size=64, Wavelength=2e-4))
 assert fringes["Phase"].shape == (64, 64) and fringes["Phase"].max() > 2 * np.pi
 print("RT Schlieren colour, shadowgraph and interferogram (with its phase): ok")
 

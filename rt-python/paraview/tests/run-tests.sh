@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# ParaView tests of the rtvis plugin (Debian's paraview 5.11: pvpython,
-# MPI-enabled pvbatch; python3-mpi4py):
+# ParaView tests of the rtvis plugin (Debian's paraview 5.11: the GUI under
+# xvfb-run, pvpython, MPI-enabled pvbatch; python3-mpi4py):
 #   run-tests.sh SITE_DIR OUT_DIR
 # SITE_DIR holds the installed rtvis (pip install --target SITE_DIR …);
 # OUT_DIR receives the images.
@@ -20,6 +20,13 @@ else
 fi
 echo "-- with the plugin folder on PYTHONPATH (its sitecustomize.py), as the GUI would start"
 PYTHONPATH="$plugin_dir:$site" pvpython "$here/stock_load.py"
+
+echo "-- the ParaView GUI under xvfb-run: the plugin auto-loaded (PV_PLUGIN_PATH), RT Schlieren shown"
+rm -f "$out/gui-result.txt"
+RTVIS_GUI_OUT="$out" PV_PLUGIN_PATH="$plugin_dir" PYTHONPATH="$plugin_dir:$site" \
+    timeout 300 xvfb-run -a paraview --dr --script="$here/gui_check.py" >"$out/gui.log" 2>&1 || true
+cat "$out/gui-result.txt"
+grep -q "^OK" "$out/gui-result.txt"
 
 echo "-- pvpython: both filters"
 PYTHONPATH="$plugin_dir:$site" pvpython "$here/pvpython_filters.py" "$out"
