@@ -6,7 +6,7 @@ mod support;
 use glam::DVec3;
 use rt_photo::{
     Bench, BenchError, Cutoff, CutoffError, CutoffParam, Film, FilmError, Filter, Mode, Photon,
-    Weighting,
+    Reconstruction, Weighting,
 };
 use rt_volume::{Bounds, Constant, GaussianBump, TraceParams};
 use support::{bench, knife};
@@ -85,7 +85,7 @@ fn knife_edge_matches_the_analytic_gaussian() {
     assert!(film.emitted >= 1_000_000);
     let want = |x: f64, y: f64| {
         let g = (-(x * x + y * y) / (2.0 * sigma * sigma)).exp();
-        let eps_x = -SQRT_2PI * delta / sigma * (x / sigma) * g;
+        let eps_x = -SQRT_2PI * delta * (x / sigma) * g;
         (0.5 + fh * eps_x).clamp(0.0, 1.0)
     };
     let e = rmse(&film, want);
@@ -270,7 +270,7 @@ fn shadowgraph_matches_the_linearised_gaussian() {
 
 /// ORACLES §6: as the bump weakens, the traced deflection converges to the
 /// line-of-sight integral of the gradient along the unbent ray (for the
-/// Gaussian, `−√(2π)(δ/σ)(x/σ)g(r)`), the relative difference falling
+/// Gaussian, `−√(2π)·δ·(x/σ)·g(r)`), the relative difference falling
 /// linearly with δ.
 #[test]
 fn straight_line_limit() {
@@ -443,4 +443,70 @@ fn parallel_splat_equals_serial_splat() {
         }
         assert!(serial.lost > 0 && serial.lost < 20_000);
     }
+}
+
+/// ORACLES §5 at `σ = 1 cm` (a bump in metres, as in §7's BOS vector): the
+/// deflection is an angle, `ε = −√(2π)·δ·(r/σ)·g(r)`, whatever the bump's
+/// scale (the page's earlier form carried a spurious `1/σ`, 100× here),
+/// the shadowgraph's contrast scales as `A = √(2π)·δ/σ` and the phase as
+/// `σ·δ`. Knife edge, shadowgraph and interferometry, with the sheet.
+#[test]
+fn oracles_hold_for_a_bump_of_one_centimetre() {
+    let (delta, sigma) = (1e-4, 0.01);
+    let f = GaussianBump::new(DVec3::ZERO, delta, sigma, 5.0);
+    let scaled = |mode: Mode, film_distance: f64| Bench {
+        center: DVec3::new(0.0, 0.0, -6.0 * sigma),
+        width: 6.0 * sigma,
+        height: 6.0 * sigma,
+        image_plane: 6.0 * sigma,
+        film_distance,
+        reconstruction: Reconstruction::Sheet,
+        ..bench(mode, 4)
+    };
+    // Worst |image − want| over pixels within 2.5σ of the axis.
+    let worst = |film: &Film, value: &dyn Fn(usize) -> f64, want: &dyn Fn(f64, f64) -> f64| {
+        let mut w: f64 = 0.0;
+        for j in 0..film.height() {
+            for i in 0..film.width() {
+                let (x, y) = centre(film, i, j);
+                if x * x + y * y < 2.5 * 2.5 {
+                    w = w.max((value(i + film.width() * j) - want(x * sigma, y * sigma)).abs());
+                }
+            }
+        }
+        w
+    };
+    let g = |x: f64, y: f64| (-(x * x + y * y) / (2.0 * sigma * sigma)).exp();
+
+    let fh = 1500.0;
+    let mut film = Film::new(48, 48, Filter::Tent).unwrap();
+    scaled(knife(fh), 0.0).render(&f, &mut film, 0, 3).unwrap();
+    let img = film.normalized_f64();
+    let knife_want =
+        |x: f64, y: f64| (0.5 - fh * SQRT_2PI * delta * (x / sigma) * g(x, y)).clamp(0.0, 1.0);
+    let e = worst(&film, &|p| img[p][0], &knife_want);
+    assert!(e < 5e-3, "knife edge: worst {e}");
+    assert!(worst(&film, &|p| img[p][0], &|_, _| 0.5) > 0.1, "the signal is there");
+
+    let l = 1.0;
+    let mut film = Film::new(48, 48, Filter::Tent).unwrap();
+    scaled(Mode::Schlieren(Cutoff::None), l).render(&f, &mut film, 0, 5).unwrap();
+    let img = film.normalized_f64();
+    let a = SQRT_2PI * delta / sigma;
+    let shadow_want = |x: f64, y: f64| {
+        let r2 = (x * x + y * y) / (sigma * sigma);
+        1.0 + l * a * g(x, y) * (2.0 - r2)
+    };
+    let e = worst(&film, &|p| img[p][0], &shadow_want);
+    assert!(e < 5e-3, "shadowgraph: worst {e}");
+    assert!(worst(&film, &|p| img[p][0], &|_, _| 1.0) > 0.04, "the 5 % signal is there");
+
+    let lambda = 2.0 * SQRT_2PI * sigma * delta / 1.5; // φ(0) = 1.5π
+    let mode = Mode::Interferometry { lambda, n_ref: 1.0, fringe_spacing: None };
+    let mut film = Film::new(48, 48, Filter::Tent).unwrap();
+    scaled(mode, 0.0).render(&f, &mut film, 0, 7).unwrap();
+    let phase = film.mean_phase();
+    let phi0 = core::f64::consts::TAU / lambda * SQRT_2PI * sigma * delta;
+    let e = worst(&film, &|p| phase[p].unwrap_or(f64::NAN), &|x, y| phi0 * g(x, y));
+    assert!(e < 5e-3 * phi0, "phase: worst {e} rad of {phi0}");
 }

@@ -101,7 +101,7 @@ fn knife_edge_matches_the_analytic_gaussian_with_few_photons() {
     let f = GaussianBump::new(DVec3::ZERO, delta, sigma, 5.0);
     let want = |x: f64, y: f64| {
         let g = (-(x * x + y * y) / (2.0 * sigma * sigma)).exp();
-        (0.5 - fh * SQRT_2PI * delta / sigma * (x / sigma) * g).clamp(0.0, 1.0)
+        (0.5 - fh * SQRT_2PI * delta * (x / sigma) * g).clamp(0.0, 1.0)
     };
     let film = render(&sheet(knife(fh), 2), &f, 128, 128, 4);
     let e = rmse(&film, 10.0, want);

@@ -129,7 +129,7 @@ fn luneburg_lens_focuses_a_parallel_beam() {
     }
 }
 
-/// §5: a weak Gaussian bump deflects by `ε(r) = −√(2π)(δ/σ)(r/σ) g(r) r̂`
+/// §5: a weak Gaussian bump deflects by `ε(r) = −√(2π)·δ·(r/σ)·g(r)·r̂`
 /// and delays the phase by `√(2π) σ δ g(r)` of optical path (first order in
 /// δ: relative agreement ~δ).
 #[test]
