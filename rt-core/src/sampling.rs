@@ -31,6 +31,12 @@ pub fn uniform(rng: &mut Rng) -> f32 {
     (rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
+/// A uniform `f64` in `[0, 1)` with 53 random bits.
+#[inline]
+pub fn uniform_f64(rng: &mut Rng) -> f64 {
+    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
 /// A uniform point in `[0, 1)²`.
 #[inline]
 pub fn uniform2(rng: &mut Rng) -> Vec2 {

@@ -16,6 +16,8 @@
 //! thread count (feature `parallel`). Beside the image the film keeps, per
 //! pixel, the photons' mean deflection ([`Film::mean_deflection`]) and,
 //! for interferometry, their mean phase, unwrapped ([`Film::mean_phase`]).
+//! A [`Sensor`] records an image as a camera would: exposure, shot and
+//! read noise, full well, bit depth.
 //!
 //! The `rt-volume` types this crate's API takes are re-exported at the
 //! root ([`IndexField`], [`GridField`], [`Octree`], [`TraceParams`], …),
@@ -78,11 +80,13 @@ mod bench;
 mod cutoff;
 mod film;
 mod math;
+mod sensor;
 mod sheet;
 
 pub use bench::{Bench, BenchError, Mode, Reconstruction, Weighting};
 pub use cutoff::{Cutoff, CutoffError, CutoffParam, FilterImage};
 pub use film::{Film, FilmError, Filter, Photon};
+pub use sensor::{Sensor, SensorError};
 // The types in this crate's signatures, from the crates below it (and
 // `build_octree`, the only way to the `Octree` that `render_grid` takes).
 pub use rt_core::ColorMap;

@@ -26,6 +26,14 @@ mod imp {
     pub(crate) fn atan2(y: f64, x: f64) -> f64 {
         y.atan2(x)
     }
+    #[inline]
+    pub(crate) fn ln(x: f64) -> f64 {
+        x.ln()
+    }
+    #[inline]
+    pub(crate) fn exp(x: f64) -> f64 {
+        x.exp()
+    }
 }
 
 #[cfg(all(not(feature = "std"), feature = "libm"))]
@@ -53,6 +61,14 @@ mod imp {
     #[inline]
     pub(crate) fn atan2(y: f64, x: f64) -> f64 {
         libm::atan2(y, x)
+    }
+    #[inline]
+    pub(crate) fn ln(x: f64) -> f64 {
+        libm::log(x)
+    }
+    #[inline]
+    pub(crate) fn exp(x: f64) -> f64 {
+        libm::exp(x)
     }
 }
 

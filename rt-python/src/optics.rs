@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use clap::ValueEnum;
 use numpy::{
-    IntoPyArray, PyArray2, PyArray3,
+    IntoPyArray, PyArray2, PyArray3, PyReadonlyArray2,
     ndarray::{Array2, Array3},
 };
 use pyo3::prelude::*;
@@ -15,7 +15,7 @@ use rt_cli::{
     optics::{Axis, Interpolation, Quantity, Samples},
     schlieren::{Args, CutoffKind, Estimator, prepare},
 };
-use rt_photo::{Bench, Mode, Reconstruction};
+use rt_photo::{Bench, Mode, Reconstruction, Sensor};
 use rt_volume::GLADSTONE_DALE_AIR;
 
 use crate::{value_error, volume::PyVolume};
@@ -151,4 +151,28 @@ pub(crate) fn optics<'py>(
         background,
         chosen,
     ))
+}
+
+/// Records an intensity image (1 = background) as a camera sensor would
+/// (`rt_photo::Sensor`): counts of `bits` bits.
+#[pyfunction]
+#[pyo3(name = "_record")]
+#[pyo3(signature = (image, exposure, full_well, bits, shot_noise, read_noise, seed))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn record<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray2<'py, f64>,
+    exposure: f64,
+    full_well: f64,
+    bits: u32,
+    shot_noise: bool,
+    read_noise: f64,
+    seed: u64,
+) -> PyResult<Bound<'py, PyArray2<u16>>> {
+    let sensor = Sensor { exposure, full_well, bits, shot_noise, read_noise };
+    let view = image.as_array();
+    let (h, w) = view.dim();
+    let data: Vec<f64> = view.iter().copied().collect();
+    let counts = py.detach(|| sensor.record(&data, w, h, seed)).map_err(value_error)?;
+    Ok(Array2::from_shape_vec((h, w), counts).map_err(value_error)?.into_pyarray(py))
 }

@@ -172,3 +172,23 @@ def test_read_volume_reads_what_rt_reads(tmp_path):
     d = rtvis.read_volume(tmp_path / "v.json", k=1e-3)
     # (rounded to float32 once, from float64: within one float32 step)
     np.testing.assert_allclose(d.index(), 1.0 + 1e-3 * data.astype(np.float64), rtol=6e-8)
+
+
+def test_record_is_the_sensor_model(gaussian):
+    vol, _, _ = gaussian
+    img = rtvis.schlieren(vol, size=64, f=1.0, h=4e-4, dtype=np.float64)
+    counts = rtvis.record(img, exposure=1000.0, full_well=4000.0, bits=12)
+    assert counts.dtype == np.uint16 and counts.shape == img.shape
+    want = np.floor(np.minimum(1000.0 * img, 4000.0) / 4000.0 * 4095.0 + 0.5).astype(np.uint16)
+    assert np.array_equal(counts, want)  # noise off: the definition, exactly
+    flat = np.ones((128, 128))
+    noisy = rtvis.record(flat, exposure=2000.0, full_well=65535.0, bits=16, shot_noise=True, seed=3)
+    assert abs(noisy.mean() - 2000.0) < 4 * (2000.0 / flat.size) ** 0.5
+    assert abs(noisy.var() / 2000.0 - 1.0) < 0.05
+    assert np.array_equal(noisy, rtvis.record(flat, exposure=2000.0, full_well=65535.0, shot_noise=True, seed=3))
+    with pytest.raises(ValueError, match="bits must be 1 to 16"):
+        rtvis.record(flat, bits=17)
+    with pytest.raises(ValueError, match="negative"):
+        rtvis.record(-flat)
+    with pytest.raises(ValueError, match="exposure must be finite and ≥ 0"):
+        rtvis.record(flat, exposure=-1.0)
