@@ -17,7 +17,9 @@
 //! pixel, the photons' mean deflection ([`Film::mean_deflection`]) and,
 //! for interferometry, their mean phase, unwrapped ([`Film::mean_phase`]).
 //! A [`Sensor`] records an image as a camera would: exposure, shot and
-//! read noise, full well, bit depth.
+//! read noise, full well, bit depth. [`Bos`] renders background-oriented
+//! schlieren through a [`ThinLens`] camera: the reference and flow images
+//! of a [`DotBackground`] and the ground-truth displacement.
 //!
 //! The `rt-volume` types this crate's API takes are re-exported at the
 //! root ([`IndexField`], [`GridField`], [`Octree`], [`TraceParams`], …),
@@ -77,6 +79,7 @@ extern crate alloc;
 extern crate std;
 
 mod bench;
+mod bos;
 mod cutoff;
 mod film;
 mod math;
@@ -84,6 +87,7 @@ mod sensor;
 mod sheet;
 
 pub use bench::{Bench, BenchError, Mode, Reconstruction, Weighting};
+pub use bos::{Bos, BosError, BosImages, DotBackground, ThinLens};
 pub use cutoff::{Cutoff, CutoffError, CutoffParam, FilterImage};
 pub use film::{Film, FilmError, Filter, Photon};
 pub use sensor::{Sensor, SensorError};
