@@ -128,6 +128,37 @@ pub fn write_rgb8(rgb: &[u8], width: u32, height: u32, path: &Path) -> Result<()
     encode(path, (width, height), format, true, None, rgb)
 }
 
+/// Writes sensor counts (rows top first) of `bits` bits as a grey PNG:
+/// 8-bit for `bits ≤ 8`, else 16-bit with the counts in the high bits
+/// (scaled by `2^(16 − bits)`), linear (gAMA 1.0), as a camera writes raw
+/// frames; creates the folder.
+///
+/// # Errors
+/// [`WriteError`] naming the file or folder.
+///
+/// # Panics
+/// If `counts` does not hold `width × height` samples.
+pub fn write_counts(
+    counts: &[u16],
+    bits: u32,
+    width: u32,
+    height: u32,
+    path: &Path,
+) -> Result<(), WriteError> {
+    assert_eq!(counts.len() as u64, u64::from(width) * u64::from(height), "counts buffer size");
+    let text = format!("rt: sensor counts of {bits} bits");
+    if bits <= 8 {
+        let data: Vec<u8> = counts.iter().map(|&c| c.min(255) as u8).collect();
+        let format = (png::ColorType::Grayscale, png::BitDepth::Eight);
+        encode(path, (width, height), format, false, Some(&text), &data)
+    } else {
+        let shift = 16 - bits.min(16);
+        let data: Vec<u8> = counts.iter().flat_map(|&c| (c << shift).to_be_bytes()).collect();
+        let format = (png::ColorType::Grayscale, png::BitDepth::Sixteen);
+        encode(path, (width, height), format, false, Some(&text), &data)
+    }
+}
+
 /// Composites `frame` (premultiplied) over an opaque vertical gradient
 /// of linear RGB, `top` in the first row to `bottom` in the last (equal
 /// for a plain colour): `c + (1 − α)·background`, alpha 1 everywhere.

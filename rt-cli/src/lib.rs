@@ -9,6 +9,9 @@
 //! - `rt schlieren FILE`: the optical bench on your own volume (NRRD, raw +
 //!   JSON, VTK image data), on the fast path (octree skipping and beam
 //!   masks) by default;
+//! - `rt bos FILE`: background-oriented schlieren of your volume: the
+//!   reference and flow images of a dotted background through a thin-lens
+//!   camera and sensor, and the true displacement;
 //! - `rt view MESH`: a ray-traced picture of a mesh (OBJ, PLY, VTK)
 //!   coloured by one of its scalars;
 //! - `rt info FILE`: what a volume or mesh holds;
@@ -22,6 +25,7 @@
 //! `run` function), so they can be driven and tested without a process.
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
+pub mod bos;
 pub mod demo;
 pub mod distributed;
 mod figure;
@@ -55,6 +59,9 @@ pub enum Command {
     Demo(demo::Args),
     /// Synthetic schlieren, shadowgraph or interferogram of a volume file.
     Schlieren(schlieren::Args),
+    /// Background-oriented schlieren of a volume file: the reference and
+    /// flow images of a dotted background and the true displacement.
+    Bos(bos::Args),
     /// Ray-trace a mesh file coloured by one of its scalars.
     View(view::Args),
     /// Describe a volume or mesh file: size, geometry, value ranges.
@@ -72,6 +79,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Demo(a) => demo::run(&a),
         Command::Schlieren(a) => schlieren::run(&a),
+        Command::Bos(a) => bos::run(&a),
         Command::View(a) => view::run(&a),
         Command::Info(a) => info::run(&a),
         Command::Distributed(a) => distributed::run(&a),

@@ -333,3 +333,79 @@ fn schlieren_writes_a_figure_and_a_16_bit_image_on_request() {
     assert!(!dir.join("again-16bit.png").exists(), "no --raw16, no 16-bit image");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `rt bos`: a small volume gives the pair, the displacement image and
+/// its raw + JSON, deterministically; the displacement read back from the
+/// raw file is what the printed summary says; noise options change the
+/// flow image but not the truth; bad files and options are one-line
+/// errors.
+#[test]
+fn bos_writes_a_pair_and_its_true_displacement() {
+    let dir = scratch("bos");
+    let vol = bump_volume(&dir, false);
+    let run = |stem: &str, extra: &[&str]| {
+        let out = dir.join(format!("{stem}.png"));
+        let mut args =
+            vec!["bos", vol.to_str().unwrap(), "--size", "40", "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = rt(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stdout(&o)
+    };
+    let said = run("a", &[]);
+    run("b", &[]);
+    for f in [
+        "a-reference.png",
+        "a-flow.png",
+        "a-displacement.png",
+        "a-displacement.json",
+        "a-displacement.raw",
+    ] {
+        assert!(dir.join(f).exists(), "{f}: {said}");
+    }
+    assert!(said.contains("40×40") && said.contains("displacement max"), "{said}");
+    for f in ["flow.png", "displacement.raw"] {
+        assert_eq!(
+            std::fs::read(dir.join(format!("a-{f}"))).unwrap(),
+            std::fs::read(dir.join(format!("b-{f}"))).unwrap()
+        );
+    }
+    let raw = std::fs::read(dir.join("a-displacement.raw")).unwrap();
+    assert_eq!(raw.len(), 40 * 40 * 2 * 4);
+    let max = raw
+        .chunks(8)
+        .map(|c| {
+            let x = f32::from_le_bytes(c[..4].try_into().unwrap());
+            let y = f32::from_le_bytes(c[4..].try_into().unwrap());
+            f64::from(x).hypot(f64::from(y))
+        })
+        .fold(0.0, f64::max);
+    assert!(max > 0.05, "the bump moves the background: max {max} px");
+    assert!(said.contains(&format!("displacement max {max:.3} px")), "{said} vs {max}");
+    // Noise changes the recorded image, not the truth.
+    run("n", &["--shot-noise", "--read-noise", "5"]);
+    assert_ne!(
+        std::fs::read(dir.join("a-flow.png")).unwrap(),
+        std::fs::read(dir.join("n-flow.png")).unwrap()
+    );
+    assert_eq!(
+        std::fs::read(dir.join("a-displacement.raw")).unwrap(),
+        std::fs::read(dir.join("n-displacement.raw")).unwrap()
+    );
+    // Bad input.
+    fails_with(&rt(&["bos", dir.join("missing.nrrd").to_str().unwrap()]), &["missing.nrrd"]);
+    let o = rt(&["bos", vol.to_str().unwrap(), "--f-number", "-2"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let o = rt(&[
+        "bos",
+        vol.to_str().unwrap(),
+        "--distance",
+        "0.05",
+        "--out",
+        dir.join("x.png").to_str().unwrap(),
+    ]);
+    fails_with(&o, &["farther from the lens"]);
+    let help = rt(&["bos", "--help"]);
+    assert!(help.status.success() && stdout(&help).contains("--background-distance"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

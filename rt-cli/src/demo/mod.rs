@@ -23,7 +23,11 @@
 //!   `schlieren-color.png` (hue-wheel colour filter: hue = direction of
 //!   deflection, saturation = its size), each with its `-figure.png`
 //!   (axes in metres, scale bar, the optics in the title, the colour
-//!   filter's legend) as `rt schlieren` writes it.
+//!   filter's legend) as `rt schlieren` writes it; and
+//!   background-oriented schlieren as `rt bos` writes it:
+//!   `bos-reference.png`, `bos-flow.png` (a random-dot background without
+//!   and with the flow) and `bos-displacement.png` (+ `.json`/`.raw`: the
+//!   true displacement in pixels).
 mod optics;
 
 pub use optics::{blast_wave, blast_wave_with};

@@ -8,6 +8,7 @@ use anyhow::Context;
 use rt_volume::io;
 
 use crate::{
+    bos,
     optics::{Interpolation, Volume},
     schlieren,
 };
@@ -52,5 +53,10 @@ pub(crate) fn render_all(out: &Path) -> anyhow::Result<()> {
         a.out = path;
         schlieren::render(&volume, &a).with_context(|| name.to_string())?;
     }
+    // Background-oriented schlieren: the pair and the true displacement,
+    // exactly as `rt bos` renders a user's file.
+    let mut a = bos::Args::from_args(Path::new("built-in"), ["--size", "384"])?;
+    a.out = out.join("bos.png");
+    bos::render(&volume, &a).context("bos.png")?;
     Ok(())
 }

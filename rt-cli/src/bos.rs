@@ -1,0 +1,240 @@
+//! `rt bos`: background-oriented schlieren of a volume file: the
+//! reference and flow images of a random-dot background seen through the
+//! flow by a thin-lens camera, and the ground-truth displacement.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use rt_photo::{Bos, DotBackground, FilterImage, Sensor, ThinLens, TraceParams};
+use rt_volume::{glam::DVec3, io::read_grid};
+
+use crate::{
+    image,
+    optics::{Axis, Interpolation, Samples, Volume},
+    parse,
+};
+
+/// `rt bos FILE`: options.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The volume: NRRD, raw + JSON sidecar or VTK image data.
+    pub file: PathBuf,
+    /// What the samples are.
+    #[command(flatten)]
+    pub samples: Samples,
+    /// Light travels along this axis, from the background through the flow
+    /// to the camera (the image axes are those of `rt schlieren`).
+    #[arg(long, value_enum, default_value_t = Axis::Z)]
+    pub axis: Axis,
+    /// Image width in pixels (height follows the volume's aspect).
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    pub size: u32,
+    /// Lens focal length in metres.
+    #[arg(long, default_value_t = 0.1, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub focal_length: f64,
+    /// f-number N (aperture diameter f/N): larger blurs the flow less.
+    #[arg(long, default_value_t = 16.0, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub f_number: f64,
+    /// Sensor pixel pitch in metres.
+    #[arg(long, default_value_t = 5e-6, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub pixel: f64,
+    /// Distance from the lens to the volume's centre (Z_A) in metres
+    /// [default: the volume's cross-section fills the image width].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub distance: Option<f64>,
+    /// Distance from the volume's centre to the background (Z_D) in
+    /// metres [default: the camera's distance, Z_A].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub background_distance: Option<f64>,
+    /// Dot diameter on the image, pixels (full width at half maximum).
+    #[arg(long, default_value_t = 3.0, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub dot: f64,
+    /// Distance between dots on the image, pixels.
+    #[arg(long, default_value_t = 4.0, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub spacing: f64,
+    /// k: k × k stratified aperture samples per pixel.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub samples_per_axis: u32,
+    /// Sensor: electrons at the brightest dot's centre (about 1 in the
+    /// background's units).
+    #[arg(long, default_value_t = 8000.0, value_parser = parse::finite, allow_hyphen_values = true)]
+    pub exposure: f64,
+    /// Sensor full well, electrons.
+    #[arg(long, default_value_t = 10000.0, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub full_well: f64,
+    /// Sensor bit depth (8: 8-bit PNGs; more: 16-bit PNGs).
+    #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub bits: u32,
+    /// Photon shot noise (Poisson).
+    #[arg(long)]
+    pub shot_noise: bool,
+    /// Read noise, electrons rms.
+    #[arg(long, default_value_t = 0.0, value_parser = parse::finite, allow_hyphen_values = true)]
+    pub read_noise: f64,
+    /// Seed of the dots, the samples and the noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output stem: writes `<stem>-reference.png`, `<stem>-flow.png`,
+    /// `<stem>-displacement.png` (hue: direction, saturation: size) and
+    /// `<stem>-displacement.json` + `.raw` (float32 Δx, Δy per pixel, in
+    /// pixels, x right and y down).
+    #[arg(long, default_value = "out/bos.png")]
+    pub out: PathBuf,
+}
+
+/// Runs `rt bos`.
+///
+/// # Errors
+/// An unreadable or unsuitable volume, a bad set-up, an unwritable output.
+pub fn run(a: &Args) -> anyhow::Result<()> {
+    let grid = read_grid(&a.file)?;
+    let volume = Volume::new(grid, a.samples.quantity, a.samples.k, false, Interpolation::Linear)
+        .with_context(|| a.file.display().to_string())?;
+    render(&volume, a)
+}
+
+/// Renders `volume` as `a` says (its file and sample options aside),
+/// writes the images and prints one summary line.
+///
+/// # Errors
+/// A bad set-up or an unwritable output.
+pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
+    let t = std::time::Instant::now();
+    let b = volume.field.grid().bounds();
+    let (axis, u) = match a.axis {
+        Axis::X => (DVec3::X, DVec3::Y),
+        Axis::Y => (DVec3::Y, DVec3::Z),
+        Axis::Z => (DVec3::Z, DVec3::X),
+    };
+    let v = axis.cross(u);
+    let ext = b.max - b.min;
+    let (width_m, height_m) = (ext.dot(u), ext.dot(v));
+    let w = a.size as usize;
+    let h = ((f64::from(a.size) * height_m / width_m).round() as usize).max(1);
+    let f = a.focal_length;
+    // The volume's width (and 5 % margin) fills the sensor at the mid-plane.
+    let z_a = a.distance.unwrap_or(f + f * 1.05 * width_m / (w as f64 * a.pixel));
+    let z_d = a.background_distance.unwrap_or(z_a);
+    if z_a <= f {
+        bail!("the volume must be farther from the lens ({z_a} m) than its focal length ({f} m)");
+    }
+    let centre = 0.5 * (b.min + b.max);
+    let camera = ThinLens {
+        // On the +axis side looking back along −axis: light travels
+        // +axis, and the image's x runs along u as in `rt schlieren`.
+        position: centre + z_a * axis,
+        direction: -axis,
+        up: v,
+        focal_length: f,
+        f_number: a.f_number,
+        focus_distance: z_a + z_d,
+        pixel_pitch: a.pixel,
+        width: w,
+        height: h,
+    };
+    let base = TraceParams::for_grid(&volume.field);
+    let bos = Bos {
+        camera,
+        background_distance: z_a + z_d,
+        background: DotBackground::for_camera(&camera, a.dot, a.spacing, a.seed),
+        aperture_samples: a.samples_per_axis,
+        params: TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base },
+    };
+    let images = bos.render(&volume.field, a.seed)?;
+    let sensor = Sensor {
+        exposure: a.exposure,
+        full_well: a.full_well,
+        bits: a.bits,
+        shot_noise: a.shot_noise,
+        read_noise: a.read_noise,
+    };
+    let (w32, h32) = (w as u32, h as u32);
+    let reference = sensor.record(&images.reference, w, h, a.seed)?;
+    let flow = sensor.record(&images.flow, w, h, a.seed.wrapping_add(1))?;
+    let paths = [
+        image::beside(&a.out, "reference"),
+        image::beside(&a.out, "flow"),
+        image::beside(&a.out, "displacement"),
+    ];
+    image::write_counts(&reference, a.bits, w32, h32, &paths[0])?;
+    image::write_counts(&flow, a.bits, w32, h32, &paths[1])?;
+    let mags: Vec<f64> = images.displacement.iter().map(|d| d[0].hypot(d[1])).collect();
+    let mut sorted = mags.clone();
+    sorted.sort_by(f64::total_cmp);
+    let p99 = sorted[((sorted.len() - 1) as f64 * 0.99) as usize].max(1e-6);
+    let max = sorted.last().copied().unwrap_or(0.0);
+    // Hue: direction (x right, y up on the wheel); saturation: |Δ| over
+    // the largest (the wheel is black beyond its rim).
+    let wheel = FilterImage::hue_wheel(256, max.max(1e-9) * 1.000_001);
+    let rgb: Vec<u8> = images
+        .displacement
+        .iter()
+        .flat_map(|d| {
+            let c = wheel.at(d[0], -d[1]);
+            c.map(|x| (rt_core::frame::linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0).round() as u8)
+        })
+        .collect();
+    image::write_rgb8(&rgb, w32, h32, &paths[2])?;
+    let raw = a.out.with_file_name(format!(
+        "{}-displacement.raw",
+        a.out.file_stem().map_or("bos".into(), |s| s.to_string_lossy())
+    ));
+    write_displacement(&raw, &images.displacement, w, h)?;
+    let m = camera.magnification();
+    println!(
+        "wrote {}, {}, {}, {} ({w}×{h}, {} rays in {:.2} s; f = {f} m at f/{}, Z_A = {z_a:.3} m, Z_D = {z_d:.3} m, M = {m:.4e}; displacement max {max:.3} px, 99th percentile {p99:.3} px)",
+        paths[0].display(),
+        paths[1].display(),
+        paths[2].display(),
+        raw.with_extension("json").display(),
+        w * h * (a.samples_per_axis * a.samples_per_axis) as usize,
+        t.elapsed().as_secs_f64(),
+        a.f_number,
+    );
+    Ok(())
+}
+
+/// Writes the displacement as raw little-endian float32 `(Δx, Δy)` per
+/// pixel with a JSON sidecar (`rt`'s raw + JSON format, two components).
+fn write_displacement(raw: &Path, d: &[[f64; 2]], w: usize, h: usize) -> anyhow::Result<()> {
+    if let Some(dir) = raw.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    }
+    let bytes: Vec<u8> =
+        d.iter().flat_map(|p| p.map(|x| x as f32)).flat_map(f32::to_le_bytes).collect();
+    std::fs::write(raw, bytes).with_context(|| raw.display().to_string())?;
+    let json = serde_json::json!({
+        "dims": [w, h],
+        "components": 2,
+        "dtype": "float32",
+        "endian": "little",
+        "file": raw.file_name().map(|f| f.to_string_lossy().into_owned()),
+        "description": "BOS ground-truth displacement (dx, dy) per pixel, in pixels, x right and y down, rows top first",
+    });
+    let path = raw.with_extension("json");
+    std::fs::write(&path, serde_json::to_string_pretty(&json)?)
+        .with_context(|| path.display().to_string())?;
+    Ok(())
+}
+
+impl Args {
+    /// The options `rt bos FILE ARGS…` would parse to.
+    ///
+    /// # Errors
+    /// What clap reports for bad arguments.
+    pub fn from_args<I, T>(file: &Path, args: I) -> Result<Self, clap::Error>
+    where
+        I: IntoIterator<Item = T>,
+        T: Into<std::ffi::OsString> + Clone,
+    {
+        #[derive(clap::Parser)]
+        struct Wrap {
+            #[command(flatten)]
+            args: Args,
+        }
+        let argv = ["bos".into(), file.as_os_str().to_owned()]
+            .into_iter()
+            .chain(args.into_iter().map(Into::into));
+        <Wrap as clap::Parser>::try_parse_from(argv).map(|w| w.args)
+    }
+}
