@@ -100,46 +100,11 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 /// A bad set-up or an unwritable output.
 pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
     let t = std::time::Instant::now();
-    let b = volume.field.grid().bounds();
-    let (axis, u) = match a.axis {
-        Axis::X => (DVec3::X, DVec3::Y),
-        Axis::Y => (DVec3::Y, DVec3::Z),
-        Axis::Z => (DVec3::Z, DVec3::X),
-    };
-    let v = axis.cross(u);
-    let ext = b.max - b.min;
-    let (width_m, height_m) = (ext.dot(u), ext.dot(v));
-    let w = a.size as usize;
-    let h = ((f64::from(a.size) * height_m / width_m).round() as usize).max(1);
-    let f = a.focal_length;
-    // The volume's width (and 5 % margin) fills the sensor at the mid-plane.
-    let z_a = a.distance.unwrap_or(f + f * 1.05 * width_m / (w as f64 * a.pixel));
-    let z_d = a.background_distance.unwrap_or(z_a);
-    if z_a <= f {
-        bail!("the volume must be farther from the lens ({z_a} m) than its focal length ({f} m)");
-    }
-    let centre = 0.5 * (b.min + b.max);
-    let camera = ThinLens {
-        // On the +axis side looking back along −axis: light travels
-        // +axis, and the image's x runs along u as in `rt schlieren`.
-        position: centre + z_a * axis,
-        direction: -axis,
-        up: v,
-        focal_length: f,
-        f_number: a.f_number,
-        focus_distance: z_a + z_d,
-        pixel_pitch: a.pixel,
-        width: w,
-        height: h,
-    };
-    let base = TraceParams::for_grid(&volume.field);
-    let bos = Bos {
-        camera,
-        background_distance: z_a + z_d,
-        background: DotBackground::for_camera(&camera, a.dot, a.spacing, a.seed),
-        aperture_samples: a.samples_per_axis,
-        params: TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base },
-    };
+    let bos = prepare(volume, a)?;
+    let camera = bos.camera;
+    let (w, h) = (camera.width, camera.height);
+    let (f, z_a) = (camera.focal_length, a.distance_or_default(volume));
+    let z_d = camera.focus_distance - z_a;
     let images = bos.render(&volume.field, a.seed)?;
     let sensor = Sensor {
         exposure: a.exposure,
@@ -194,6 +159,60 @@ pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The beam axis and the image's u and v axes (as `rt schlieren`'s).
+fn axes(axis: Axis) -> (DVec3, DVec3, DVec3) {
+    let (d, u) = match axis {
+        Axis::X => (DVec3::X, DVec3::Y),
+        Axis::Y => (DVec3::Y, DVec3::Z),
+        Axis::Z => (DVec3::Z, DVec3::X),
+    };
+    (d, u, d.cross(u))
+}
+
+/// The BOS set-up `a` describes for `volume` (every render of `rt bos`,
+/// the demo and rtvis goes through here): the camera on the +axis side
+/// of the volume's centre looking back along −axis (light travels +axis,
+/// so the image's x runs along u as in `rt schlieren`), focused on the
+/// background `Z_D` behind the centre; dots sized in pixels as imaged;
+/// two-cell leapfrog steps through the field.
+///
+/// # Errors
+/// The volume closer to the lens than its focal length, or a bad set-up.
+pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<Bos> {
+    let b = volume.field.grid().bounds();
+    let (axis, u, v) = axes(a.axis);
+    let ext = b.max - b.min;
+    let w = a.size as usize;
+    let h = ((f64::from(a.size) * ext.dot(v) / ext.dot(u)).round() as usize).max(1);
+    let f = a.focal_length;
+    let z_a = a.distance_or_default(volume);
+    let z_d = a.background_distance.unwrap_or(z_a);
+    if z_a <= f {
+        bail!("the volume must be farther from the lens ({z_a} m) than its focal length ({f} m)");
+    }
+    let camera = ThinLens {
+        position: 0.5 * (b.min + b.max) + z_a * axis,
+        direction: -axis,
+        up: v,
+        focal_length: f,
+        f_number: a.f_number,
+        focus_distance: z_a + z_d,
+        pixel_pitch: a.pixel,
+        width: w,
+        height: h,
+    };
+    let base = TraceParams::for_grid(&volume.field);
+    let bos = Bos {
+        camera,
+        background_distance: z_a + z_d,
+        background: DotBackground::for_camera(&camera, a.dot, a.spacing, a.seed),
+        aperture_samples: a.samples_per_axis,
+        params: TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base },
+    };
+    bos.validate()?;
+    Ok(bos)
+}
+
 /// Writes the displacement as raw little-endian float32 `(Δx, Δy)` per
 /// pixel with a JSON sidecar (`rt`'s raw + JSON format, two components).
 fn write_displacement(raw: &Path, d: &[[f64; 2]], w: usize, h: usize) -> anyhow::Result<()> {
@@ -218,6 +237,17 @@ fn write_displacement(raw: &Path, d: &[[f64; 2]], w: usize, h: usize) -> anyhow:
 }
 
 impl Args {
+    /// `--distance`, or the default: the volume's width across the image
+    /// (and a 5 % margin) fills the sensor at the volume's centre.
+    #[must_use]
+    pub fn distance_or_default(&self, volume: &Volume) -> f64 {
+        let b = volume.field.grid().bounds();
+        let (_, u, _) = axes(self.axis);
+        let f = self.focal_length;
+        self.distance
+            .unwrap_or(f + f * 1.05 * (b.max - b.min).dot(u) / (f64::from(self.size) * self.pixel))
+    }
+
     /// The options `rt bos FILE ARGS…` would parse to.
     ///
     /// # Errors

@@ -176,3 +176,50 @@ pub(crate) fn record<'py>(
     let counts = py.detach(|| sensor.record(&data, w, h, seed)).map_err(value_error)?;
     Ok(Array2::from_shape_vec((h, w), counts).map_err(value_error)?.into_pyarray(py))
 }
+
+/// `(reference [h, w], flow [h, w], displacement [h, w, 2] in pixels (x
+/// right, y down), a line describing the set-up)`.
+type BosOut<'py> =
+    (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>, String);
+
+/// Background-oriented schlieren of `volume`, set up by `rt bos`'s own
+/// options (`args`: its command-line arguments after the file).
+#[pyfunction]
+#[pyo3(name = "_bos")]
+pub(crate) fn bos<'py>(
+    py: Python<'py>,
+    volume: &PyVolume,
+    args: Vec<String>,
+) -> PyResult<BosOut<'py>> {
+    let a = rt_cli::bos::Args::from_args(std::path::Path::new("volume"), args).map_err(|e| {
+        value_error(e.to_string().lines().next().unwrap_or_default().trim_start_matches("error: "))
+    })?;
+    let v = &volume.inner;
+    let (bos, images) = py
+        .detach(|| -> anyhow::Result<_> {
+            let bos = rt_cli::bos::prepare(v, &a)?;
+            let images = bos.render(&v.field, a.seed)?;
+            Ok((bos, images))
+        })
+        .map_err(value_error)?;
+    let (w, h) = (images.width, images.height);
+    let c = bos.camera;
+    let said = format!(
+        "f = {} m at f/{}, Z_A = {:.4} m, Z_B = {:.4} m, M = {:.4e}, {}×{} pixels of {} m",
+        c.focal_length,
+        c.f_number,
+        a.distance_or_default(v),
+        bos.background_distance,
+        c.magnification(),
+        w,
+        h,
+        c.pixel_pitch
+    );
+    let disp: Vec<f64> = images.displacement.iter().flatten().copied().collect();
+    Ok((
+        Array2::from_shape_vec((h, w), images.reference).map_err(value_error)?.into_pyarray(py),
+        Array2::from_shape_vec((h, w), images.flow).map_err(value_error)?.into_pyarray(py),
+        Array3::from_shape_vec((h, w, 2), disp).map_err(value_error)?.into_pyarray(py),
+        said,
+    ))
+}

@@ -33,6 +33,7 @@ from . import _rtvis
 
 __all__ = [
     "GLADSTONE_DALE_AIR",
+    "bos",
     "Camera",
     "Scene",
     "Volume",
@@ -445,6 +446,44 @@ def color_schlieren(
     as :func:`schlieren`)."""
     return schlieren(volume, "color", half_range=half_range, axis=axis, size=size,
                      photons=photons, seed=seed, deflection=deflection, dtype=dtype)
+
+
+def bos(volume: Volume, axis: str = "z", size: int = 512, focal_length: float = 0.1,
+        f_number: float = 16.0, pixel: float = 5e-6, distance: Optional[float] = None,
+        background_distance: Optional[float] = None, dot: float = 3.0, spacing: float = 4.0,
+        samples: int = 2, seed: int = 1):
+    """Background-oriented schlieren of ``volume``, set up as ``rt bos``
+    sets it up: a thin-lens camera (``focal_length`` and ``pixel`` pitch in
+    metres, ``f_number``) at ``distance`` Z_A from the volume's centre on
+    the +``axis`` side (default: the volume fills the image width), focused
+    on a random-dot background ``background_distance`` Z_D behind the
+    centre (default Z_A); dots of ``dot`` pixels ``spacing`` pixels apart
+    as imaged; ``samples``² stratified aperture samples per pixel traced
+    backward through the field.
+
+    Returns ``(reference, flow, displacement, info)``: the background
+    without and with the flow (float64 (h, w), about 0–1; record them with
+    :func:`record` for a camera's counts and noise), the ground-truth
+    displacement of the background's image, float64 (h, w, 2) in pixels
+    (x right, y down), and a line describing the set-up. Paraxially
+    ``|Δ| = M·Z_D·|ε|/pitch``, ``M = f/(Z_A + Z_D − f)``.
+    """
+    if not isinstance(volume, Volume):
+        raise TypeError(f"volume: expected an rtvis.Volume, got {type(volume).__name__}")
+    args = ["--axis", _choice("axis", axis, ("x", "y", "z")),
+            "--size", str(_integer("size", size, 1, 8192)),
+            "--focal-length", repr(_number("focal_length", focal_length, positive=True)),
+            "--f-number", repr(_number("f_number", f_number, positive=True)),
+            "--pixel", repr(_number("pixel", pixel, positive=True)),
+            "--dot", repr(_number("dot", dot, positive=True)),
+            "--spacing", repr(_number("spacing", spacing, positive=True)),
+            "--samples-per-axis", str(_integer("samples", samples, 1, 64)),
+            "--seed", str(_integer("seed", seed, 0, 2**64 - 1))]
+    if distance is not None:
+        args += ["--distance", repr(_number("distance", distance, positive=True))]
+    if background_distance is not None:
+        args += ["--background-distance", repr(_number("background_distance", background_distance, positive=True))]
+    return _rtvis._bos(volume._v, args)
 
 
 def record(image, exposure: float = 10_000.0, full_well: float = 20_000.0, bits: int = 16,
