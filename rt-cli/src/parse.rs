@@ -2,6 +2,30 @@
 
 use rt_core::glam::Vec3;
 
+/// The options `rt NAME FILE ARGS…` would parse to for a subcommand whose
+/// options are `A` (defaults included): how the demo and the bindings
+/// drive a command exactly as a user's command line would.
+///
+/// # Errors
+/// What clap reports for bad arguments.
+pub(crate) fn subcommand<A, I, T>(
+    name: &'static str,
+    file: &std::path::Path,
+    args: I,
+) -> Result<A, clap::Error>
+where
+    A: clap::Args + clap::FromArgMatches,
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let command = A::augment_args(clap::Command::new(name));
+    let argv = [std::ffi::OsString::from(name), file.as_os_str().to_owned()]
+        .into_iter()
+        .chain(args.into_iter().map(Into::into));
+    let matches = command.try_get_matches_from(argv)?;
+    A::from_arg_matches(&matches)
+}
+
 /// The largest image edge the tools accept, in pixels.
 pub(crate) const MAX_EDGE: u32 = 16384;
 

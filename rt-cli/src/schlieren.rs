@@ -337,15 +337,7 @@ impl Args {
         I: IntoIterator<Item = T>,
         T: Into<std::ffi::OsString> + Clone,
     {
-        #[derive(clap::Parser)]
-        struct Wrap {
-            #[command(flatten)]
-            args: Args,
-        }
-        let argv = ["schlieren".into(), file.as_os_str().to_owned()]
-            .into_iter()
-            .chain(args.into_iter().map(Into::into));
-        <Wrap as clap::Parser>::try_parse_from(argv).map(|w| w.args)
+        crate::parse::subcommand("schlieren", file, args)
     }
 }
 
