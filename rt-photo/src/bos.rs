@@ -113,7 +113,12 @@ impl ThinLens {
     /// downward) see in focus.
     #[must_use]
     pub fn focus_point(&self, px: f64, py: f64) -> DVec3 {
-        let f = self.frame();
+        self.focus_point_in(&self.frame(), px, py)
+    }
+
+    /// [`ThinLens::focus_point`] in the camera's frame `f`, computed once
+    /// by the caller.
+    fn focus_point_in(&self, f: &Frame, px: f64, py: f64) -> DVec3 {
         let scale = self.pixel_pitch / self.magnification();
         self.position
             + self.focus_distance * f.axis
@@ -130,7 +135,7 @@ impl ThinLens {
         let (dx, dy) = concentric_disk(lens);
         let r = 0.5 * self.aperture();
         let origin = self.position + r * (dx * f.right + dy * f.up);
-        (origin, (self.focus_point(px, py) - origin).normalize())
+        (origin, (self.focus_point_in(&f, px, py) - origin).normalize())
     }
 }
 
