@@ -69,7 +69,13 @@ fn present_frame(buffer: u32) {
             c.triangles,
             c.ignored
         );
-        let _ = std::fs::write(dir.join("counters.txt"), line);
+        // Written beside, then renamed over: a program stopped mid-write
+        // (glxgears is stopped by a signal) leaves the previous frame's
+        // counters, never an empty file.
+        let tmp = dir.join("counters.txt.tmp");
+        if std::fs::write(&tmp, line).is_ok() {
+            let _ = std::fs::rename(&tmp, dir.join("counters.txt"));
+        }
     }
     let rendered = crate::catch(|| {
         let scene = FrameScene::build(frame)?;
