@@ -377,14 +377,16 @@ impl Bench {
         self.render_with(&|o, d| trace(field, o, d, &self.params), film, pass, seed)
     }
 
-    /// The per-node tolerance for octree skipping (see
-    /// [`rt_volume::trace_skipping`]) that this bench cannot see: a
-    /// quarter of the smallest deflection it resolves, taken as 1/1000 of
-    /// what changes the cutoff's transmission fully ([`Cutoff::range`]).
-    /// Without a cutoff the film position resolves it: 1/1000 of a pixel
-    /// after the film distance `L` (any skip is invisible at `L = 0`;
-    /// capped at 1e-3 rad). Interferometry resolves optical path: 1/1000
-    /// of a wavelength over the field's extent.
+    /// The per-ray tolerance for octree skipping (see
+    /// [`rt_volume::trace_skipping`]: the deflection skipping may change
+    /// along a whole photon's path) that this bench cannot see: the
+    /// smallest deflection it resolves, taken as 1/1000 of what changes
+    /// the cutoff's transmission fully ([`Cutoff::range`]; for a knife
+    /// edge `h/(f·1000)`: a thousand grey levels). Without a cutoff the
+    /// film position resolves it: 1/1000 of a pixel after the film
+    /// distance `L` (any skip is invisible at `L = 0`; capped at 1e-3
+    /// rad). Interferometry resolves optical path: 1/1000 of a wavelength
+    /// over the field's extent.
     #[must_use]
     pub fn skip_tolerance(&self, field: &GridField, film: &Film) -> f64 {
         let resolvable = match &self.mode {
@@ -398,7 +400,7 @@ impl Bench {
                 lambda / (b.max - b.min).length()
             }
         } / 1000.0;
-        (0.25 * resolvable).min(1e-3)
+        resolvable.min(1e-3)
     }
 
     /// [`Bench::render`] for a gridded field, rt's default: the octree

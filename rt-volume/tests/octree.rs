@@ -93,6 +93,54 @@ fn sparse_fields_are_mostly_skipped() {
     }
 }
 
+/// The tolerance is a budget for the whole ray, not for each node: on a
+/// dense field (blobs everywhere, every node a little rough) a ray that
+/// crosses many smooth nodes stops skipping once their bounds add up to
+/// the tolerance, so its exit direction stays within the tolerance of
+/// uniform stepping. (A per-node tolerance of 1e-3 let these rays spend
+/// 1.2e-3.)
+#[test]
+fn the_tolerance_bounds_the_whole_ray_on_a_dense_field() {
+    let mut spec = Vec::new();
+    for k in 0..4 {
+        for j in 0..4 {
+            for i in 0..4 {
+                let c = |v: usize| 0.125 + 0.25 * v as f64;
+                let amp = 2e-4 * (1.0 + ((i + 2 * j + 3 * k) % 5) as f64);
+                spec.push((c(i), c(j), c(k), amp, 0.07));
+            }
+        }
+    }
+    let f = blobs(&spec);
+    let tree = build_octree(&f).unwrap();
+    let p = TraceParams { tolerance: 1e-12, max_step: 1.0 / 40.0, ..TraceParams::accurate() };
+    for tol in [1e-3, 1e-4, 1e-5] {
+        let (mut used, mut skipped) = (0.0f64, 0);
+        for i in 0..12 {
+            for j in 0..12 {
+                let o = DVec3::new(0.04 + 0.08 * f64::from(i), 0.04 + 0.08 * f64::from(j), -0.5);
+                let d = DVec3::new(0.1, -0.05, 1.0);
+                let uniform = trace(&f, o, d, &p).unwrap();
+                let r = trace_skipping(&f, &tree, o, d, &p, tol).unwrap();
+                let diff = (r.direction - uniform.direction).length();
+                assert!(
+                    r.stats.skip_bound <= tol * (1.0 + 1e-9),
+                    "{tol}: {:e}",
+                    r.stats.skip_bound
+                );
+                assert!(diff <= tol, "{tol} at {o}: deflection differs by {diff:e}");
+                used = used.max(r.stats.skip_bound / tol);
+                skipped = skipped.max(r.stats.skipped);
+            }
+        }
+        // At the loosest tolerance the budget is really spent, over
+        // several nodes (finer ones skip nothing on this field).
+        if tol == 1e-3 {
+            assert!(used > 0.5 && skipped >= 2, "spent {used} of the budget, {skipped} skips");
+        }
+    }
+}
+
 /// A beam mask's clear cells are exactly safe: every ray through one is
 /// answered as the skip chain answers it (straight, no integration step),
 /// for an axis-aligned and an oblique beam; most of a sparse field's beam

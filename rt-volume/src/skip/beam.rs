@@ -5,7 +5,7 @@ use alloc::vec::Vec;
 
 use glam::DVec3;
 
-use super::{Octree, trace_skipping};
+use super::{BRICK, Octree, trace_skipping};
 use crate::{
     Bounds, Exit, GridField, IndexField, TraceError, TraceParams, TraceResult, TraceStats,
     trace::check_params,
@@ -32,16 +32,21 @@ pub struct BeamWindow {
 pub const MAX_BEAM_CELLS: usize = 1 << 26;
 
 /// For each cell of a [`BeamWindow`], whether every line of the beam
-/// through it crosses only nodes that [`trace_skipping`] would cross
-/// straight at the mask's tolerance, and a bound on `|∇n|` along them.
-/// Such a ray goes straight from entry to exit, so [`trace_beam`] answers
-/// it without walking the octree: the answer a skip chain would give.
+/// through it is one that [`trace_skipping`] crosses straight from entry
+/// to exit within its per-ray budget, and a bound on `|∇n|` along it.
+/// [`trace_beam`] answers such a ray without walking the octree: the
+/// answer a skip chain would give.
 ///
 /// Built from the shadows of the octree's partition ([`Octree::partition`])
 /// cast along the beam: each node's box (dilated by 1e-6 of a cell) is
 /// projected on the cross-section and the cells its bounding rectangle
-/// touches inherit its gradient bound, or become rough. Conservative: a
-/// cell is clear only if no rough brick's shadow touches it.
+/// touches inherit its gradient bound, or become rough. A cell is clear
+/// when no rough brick's shadow touches it and its bound `G` keeps the
+/// whole chain within budget: `G · (L + b) < tolerance · min n`, `L` the
+/// field's bounding-box diagonal (the longest straight path through it)
+/// and `b` a brick's diagonal (the skip chain takes nodes down to a brick
+/// while `spent + max|∇n| · diagonal` stays below the budget, and `spent ≤
+/// G · L`). Conservative: a clear line never needs an integration step.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BeamMask {
     center: DVec3,
@@ -54,6 +59,8 @@ pub struct BeamMask {
     /// whose shadow touches it; `+∞` where a rough brick's does.
     grad: Vec<f32>,
     tolerance: f64,
+    /// The largest `G` of a clear cell (exclusive).
+    grad_limit: f64,
     /// The field the mask was built for.
     bounds: Bounds,
     n_min: f64,
@@ -103,11 +110,16 @@ impl BeamMask {
             cells,
             grad: alloc::vec![0.0; cells[0] * cells[1]],
             tolerance,
+            grad_limit: 0.0,
             bounds: field.bounds(),
             n_min: f64::from(tree.root().min).max(1e-6),
         };
+        let budget = tolerance * mask.n_min;
+        let chord = (mask.bounds.max - mask.bounds.min).length();
+        let brick = (h * BRICK as f64).length();
+        mask.grad_limit = budget / (chord + brick);
         let scale = [cells[0] as f64 / size[0], cells[1] as f64 / size[1]];
-        tree.partition(tolerance, |node, smooth| {
+        tree.partition(budget, |node, smooth| {
             let grad = if smooth { node.stats.grad_max } else { f32::INFINITY };
             if grad == 0.0 {
                 return;
@@ -159,8 +171,8 @@ impl BeamMask {
     }
 
     /// Whether the line through `p` along the beam is clear: `Some(bound on
-    /// |∇n| along it)`, or `None` where it may meet a rough brick (or `p`
-    /// lies outside the window).
+    /// |∇n| along it)`, or `None` where it may meet a rough brick or would
+    /// spend more than the budget (or `p` lies outside the window).
     #[must_use]
     pub fn clear_at(&self, p: DVec3) -> Option<f64> {
         let r = p - self.center;
@@ -168,14 +180,15 @@ impl BeamMask {
             let s = (r.dot(axis) / self.size[k] + 0.5) * self.cells[k] as f64;
             (s >= 0.0 && s < self.cells[k] as f64).then_some(s as usize)
         };
-        let g = self.grad[cell(1, self.v)? * self.cells[0] + cell(0, self.u)?];
-        g.is_finite().then_some(f64::from(g))
+        let g = f64::from(self.grad[cell(1, self.v)? * self.cells[0] + cell(0, self.u)?]);
+        (g < self.grad_limit).then_some(g)
     }
 
     /// The fraction of cells that are clear.
     #[must_use]
     pub fn clear_fraction(&self) -> f64 {
-        self.grad.iter().filter(|g| g.is_finite()).count() as f64 / self.grad.len() as f64
+        let clear = self.grad.iter().filter(|&&g| f64::from(g) < self.grad_limit).count();
+        clear as f64 / self.grad.len() as f64
     }
 }
 

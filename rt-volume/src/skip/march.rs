@@ -20,11 +20,14 @@ pub fn build_octree(field: &GridField) -> Result<Octree, OctreeError> {
 }
 
 /// Traces like [`crate::trace`], but wherever the octree says the field is
-/// smooth (`max|∇n| · node diagonal < tolerance`) the ray crosses the whole
-/// node in one straight step. The deflection so skipped is bounded by
-/// `Σ max|∇n| · length / min n` over the skipped steps, reported as
-/// [`crate::TraceStats::skip_bound`]; `tolerance` is thus the deflection
-/// (radians) allowed per skipped node.
+/// smooth the ray crosses the whole node in one straight step. The
+/// deflection a straight step can miss is at most `max|∇n| · length /
+/// min n`; their sum over the ray, [`crate::TraceStats::skip_bound`], is
+/// the ray's **budget**: a node is crossed straight only while
+/// `spent + max|∇n| · diagonal / min n < tolerance`, `spent` the bound of
+/// the ray's earlier skips. So `tolerance` bounds the deflection (radians)
+/// that skipping can change along the whole ray, however many nodes it
+/// crosses; once it is spent, the ray is integrated step by step.
 ///
 /// # Errors
 /// As [`crate::trace`]; also [`TraceError::InvalidParams`] for a
@@ -50,8 +53,12 @@ pub fn trace_skipping(
     let tiny = 1e-9 * h.min_element();
     let cells = (DVec3::from(g.dims().map(|d| d as f64)) - 1.0).to_array();
     // The brick last found too rough to skip: the steps inside it ask no
-    // further.
+    // further (the budget only shrinks, so it stays too rough).
     let mut rough: Option<[usize; 3]> = None;
+    // The skip bound spent so far, in `max|∇n| · length` (times `n_min`,
+    // radians).
+    let budget = tolerance * n_min;
+    let mut spent = 0.0;
     trace_impl(
         field,
         origin,
@@ -84,7 +91,7 @@ pub fn trace_skipping(
                 if Some(brick) == rough {
                     break;
                 }
-                let Some(node) = tree.smooth_node_in(brick, tolerance, hint) else {
+                let Some(node) = tree.smooth_node_in(brick, budget - spent - bound, hint) else {
                     rough = Some(brick);
                     break;
                 };
@@ -127,6 +134,7 @@ pub fn trace_skipping(
                     break;
                 }
             }
+            spent += bound;
             (t > 0.0).then(|| Skip {
                 len: t,
                 bound: bound / n_min,

@@ -29,6 +29,8 @@
 //! `max|∇n| · diagonal < tolerance`: the deflection it skips is at most
 //! `∫|∇⊥n|/n ds ≤ max|∇n| · diagonal / min n`, so `tolerance` is the
 //! deflection (radians, for `n ≈ 1`) allowed per skipped node.
+//! [`crate::trace_skipping`] asks with what is left of a per-ray budget,
+//! so the sum over all the nodes a ray skips stays within its tolerance.
 
 use alloc::vec::Vec;
 

@@ -34,6 +34,9 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         "| field | method | tolerance | field evals | seconds | max deflection error | ≤ tolerance | evals vs uniform |\n|---|---|---|---|---|---|---|---|\n",
     );
     let mut verdict = String::new();
+    // The tolerance is a per-ray budget: the error stays within it on
+    // every field, dense ones included.
+    let mut over = Vec::new();
     let mut series = Vec::new();
     for (name, f) in [("sparse", sparse_bumps()), ("dense", dense_bumps())] {
         let tree = build_octree(&f).map_err(|e| e.to_string())?;
@@ -85,6 +88,9 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             )
             .unwrap();
             points.push((secs, err.max(1e-17)));
+            if err > tol {
+                over.push(format!("{name} at {tol:.0e}: {err:.1e}"));
+            }
             if name == "sparse" && err <= tol && ratio <= 0.2 && verdict.is_empty() {
                 verdict = format!(
                     "sparse: octree at tolerance {tol:.0e} uses {ratio:.3}× the field evaluations of uniform stepping with max deflection error {err:.1e} ≤ tolerance → met (target ≤ 1/5)"
@@ -96,6 +102,12 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     if verdict.is_empty() {
         verdict = "sparse: no tolerance reached ≤ 1/5 of uniform's evaluations within tolerance → NOT met".into();
     }
+    let within = if over.is_empty() {
+        "every field, every tolerance: max deflection error ≤ tolerance (a per-ray budget) → met"
+            .to_string()
+    } else {
+        format!("max deflection error over the tolerance: {} → NOT met", over.join(", "))
+    };
     std::fs::write(dir.join("octree.csv"), &csv).map_err(|e| e.to_string())?;
     let plot = Plot {
         pareto: true,
@@ -112,7 +124,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             rays.len()
         ),
         body: md,
-        verdicts: vec![verdict],
+        verdicts: vec![verdict, within],
         plots: vec![(
             "octree.png".into(),
             "max deflection error (y; 1e-17 stands for exactly 0) against seconds (x) of the skipping tracer over tolerances 1e-3 … 1e-7, one line per field; rings: Pareto front".into(),

@@ -31,7 +31,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let tree = build_octree(&f).map_err(|e| e.to_string())?;
     let h = f.grid().spacing().x;
     // Converged reference: RK4 at a quarter voxel, 256 photons per pixel,
-    // skipping only where the per-node deflection bound is below 1e-9.
+    // skipping only while the ray's deflection bound stays below 1e-9.
     let mut reference = Film::new(FILM, FILM, Filter::Box).map_err(|e| e.to_string())?;
     let rb = knife_bench(TraceParams::fixed(Method::Rk4, 0.25 * h), 16);
     rb.render_with(
