@@ -112,6 +112,7 @@ pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
         bits: a.bits,
         shot_noise: a.shot_noise,
         read_noise: a.read_noise,
+        airy: None,
     };
     let (w32, h32) = (w as u32, h as u32);
     let reference = sensor.record(&images.reference, w, h, a.seed)?;

@@ -21,6 +21,7 @@ use glam::DVec3;
 use rt_core::sampling::{rng_for, uniform_f64};
 use rt_volume::{IndexField, TraceError, TraceParams, trace};
 
+use crate::airy::Airy;
 use crate::math::{cos, floor, sin};
 
 /// A thin-lens camera: lens centre `position`, optical axis `direction`,
@@ -53,10 +54,10 @@ pub struct ThinLens {
 
 /// The camera's orthonormal frame.
 #[derive(Clone, Copy, Debug)]
-struct Frame {
-    axis: DVec3,
-    right: DVec3,
-    up: DVec3,
+pub(crate) struct Frame {
+    pub(crate) axis: DVec3,
+    pub(crate) right: DVec3,
+    pub(crate) up: DVec3,
 }
 
 impl ThinLens {
@@ -71,6 +72,22 @@ impl ThinLens {
     #[must_use]
     pub fn aperture(&self) -> f64 {
         self.focal_length / self.f_number
+    }
+
+    /// The size of a sensor pixel imaged on the focus plane,
+    /// `pitch/M` (scene units).
+    #[must_use]
+    pub fn pixel_in_focus(&self) -> f64 {
+        self.pixel_pitch / self.magnification()
+    }
+
+    /// The lens's diffraction at `wavelength` (metres) on this sensor:
+    /// the light converges on the sensor at the working f-number
+    /// `N·(1 + M)` (the image lies `f·(1 + M)` behind the lens), so the
+    /// Airy disc's first dark ring has diameter `2.44 λ N (1 + M)`.
+    #[must_use]
+    pub fn airy(&self, wavelength: f64) -> Airy {
+        Airy::new(wavelength, self.f_number * (1.0 + self.magnification()), self.pixel_pitch)
     }
 
     /// Checks the settings.
@@ -102,7 +119,7 @@ impl ThinLens {
         why.map_or(Ok(()), |w| Err(BosError::Camera(w)))
     }
 
-    fn frame(&self) -> Frame {
+    pub(crate) fn frame(&self) -> Frame {
         let axis = self.direction.normalize();
         let right = axis.cross(self.up).normalize();
         Frame { axis, right, up: right.cross(axis) }
@@ -170,7 +187,7 @@ impl DotBackground {
     /// `camera` focused on the background.
     #[must_use]
     pub fn for_camera(camera: &ThinLens, dot_px: f64, spacing_px: f64, seed: u64) -> Self {
-        let px = camera.pixel_pitch / camera.magnification();
+        let px = camera.pixel_in_focus();
         Self { spacing: spacing_px * px, dot_diameter: dot_px * px, seed }
     }
 

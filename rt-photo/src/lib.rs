@@ -16,10 +16,11 @@
 //! thread count (feature `parallel`). Beside the image the film keeps, per
 //! pixel, the photons' mean deflection ([`Film::mean_deflection`]) and,
 //! for interferometry, their mean phase, unwrapped ([`Film::mean_phase`]).
-//! A [`Sensor`] records an image as a camera would: exposure, shot and
-//! read noise, full well, bit depth. [`Bos`] renders background-oriented
-//! schlieren through a [`ThinLens`] camera: the reference and flow images
-//! of a [`DotBackground`] and the ground-truth displacement.
+//! A [`Sensor`] records an image as a camera would: diffraction blur
+//! ([`Airy`]), exposure, shot and read noise, full well, bit depth.
+//! [`Bos`] renders background-oriented schlieren through a [`ThinLens`]
+//! camera: the reference and flow images of a [`DotBackground`] and the
+//! ground-truth displacement.
 //!
 //! The `rt-volume` types this crate's API takes are re-exported at the
 //! root ([`IndexField`], [`GridField`], [`Octree`], [`TraceParams`], …),
@@ -78,6 +79,7 @@ extern crate alloc;
 #[cfg(feature = "std")]
 extern crate std;
 
+mod airy;
 mod bench;
 mod bos;
 mod cutoff;
@@ -86,6 +88,7 @@ mod math;
 mod sensor;
 mod sheet;
 
+pub use airy::{Airy, AiryKernel};
 pub use bench::{Bench, BenchError, Mode, Reconstruction, Weighting};
 pub use bos::{Bos, BosError, BosImages, DotBackground, ThinLens};
 pub use cutoff::{Cutoff, CutoffError, CutoffParam, FilterImage};

@@ -8,6 +8,11 @@
 //! `DN = round(e_recorded / full_well · (2^bits − 1))`. With the noise off
 //! (the default) the record is exact: `DN = round(min(E·I, FW)/FW · (2^bits − 1))`.
 //!
+//! With [`Sensor::airy`] set, the image is first blurred by the lens's
+//! diffraction ([`Airy`]: an Airy pattern whose first dark ring has
+//! diameter `2.44 λN`), as light is spread before the pixels count it;
+//! off by default.
+//!
 //! Deterministic: pixel `p`'s noise comes from its own random stream
 //! `(seed, p)`, so the same seed gives the same counts whatever the order
 //! (or thread) pixels are recorded in; record a reference image and a flow
@@ -25,6 +30,7 @@ use core::fmt;
 
 use rt_core::sampling::{Rng, rng_for, uniform_f64};
 
+use crate::airy::Airy;
 use crate::math::{cos, exp, floor, ln, sqrt};
 
 /// Sensor settings.
@@ -40,11 +46,14 @@ pub struct Sensor {
     pub shot_noise: bool,
     /// Read noise, electrons rms (0: none).
     pub read_noise: f64,
+    /// Diffraction blur applied to the image before the pixels count it
+    /// (`None`: none).
+    pub airy: Option<Airy>,
 }
 
 impl Default for Sensor {
     /// A 16-bit sensor exposed to half its 20 000 e⁻ full well at the
-    /// background, noise off.
+    /// background, noise and diffraction blur off.
     fn default() -> Self {
         Self {
             exposure: 10_000.0,
@@ -52,6 +61,7 @@ impl Default for Sensor {
             bits: 16,
             shot_noise: false,
             read_noise: 0.0,
+            airy: None,
         }
     }
 }
@@ -81,6 +91,15 @@ pub enum SensorError {
         /// Its value.
         value: f64,
     },
+    /// The [`Airy`] wavelength is not finite and > 0.
+    Wavelength(f64),
+    /// The [`Airy`] f-number is not finite and > 0.
+    FNumber(f64),
+    /// The [`Airy`] pixel pitch is not finite and > 0.
+    PixelPitch(f64),
+    /// The [`Airy`] pattern is too wide for the pixels: `λN` (given, in
+    /// pixels) above 24, whose kernel would pass 512 pixels in radius.
+    AiryTooWide(f64),
 }
 
 impl fmt::Display for SensorError {
@@ -101,6 +120,17 @@ impl fmt::Display for SensorError {
             Self::Sample { index, value } => {
                 write!(f, "intensity {index} is {value}: must be finite and ≥ 0")
             }
+            Self::Wavelength(v) => {
+                write!(f, "diffraction: wavelength must be finite and > 0 metres (got {v})")
+            }
+            Self::FNumber(v) => write!(f, "diffraction: f-number must be finite and > 0 (got {v})"),
+            Self::PixelPitch(v) => {
+                write!(f, "diffraction: pixel pitch must be finite and > 0 metres (got {v})")
+            }
+            Self::AiryTooWide(v) => write!(
+                f,
+                "diffraction: λN is {v} pixels, at most about 24 (an Airy kernel of at most 512 pixels in radius)"
+            ),
         }
     }
 }
@@ -125,6 +155,9 @@ impl Sensor {
         if !(self.read_noise.is_finite() && self.read_noise >= 0.0) {
             return Err(SensorError::ReadNoise(self.read_noise));
         }
+        if let Some(a) = &self.airy {
+            a.validate()?;
+        }
         Ok(())
     }
 
@@ -136,7 +169,7 @@ impl Sensor {
 
     /// Records `image` (`width × height` intensities, row-major, 1 = the
     /// background) as counts, pixel `p`'s noise drawn from stream
-    /// `(seed, p)`.
+    /// `(seed, p)`; blurred first by [`Sensor::airy`] if set.
     ///
     /// # Errors
     /// A bad setting, an image of the wrong size, or a sample that is not
@@ -149,13 +182,15 @@ impl Sensor {
         seed: u64,
     ) -> Result<Vec<u16>, SensorError> {
         self.validate()?;
-        let expected = width.checked_mul(height).unwrap_or(0);
-        if expected == 0 || image.len() != expected {
-            return Err(SensorError::ImageSize { expected, found: image.len() });
-        }
-        if let Some(index) = image.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
-            return Err(SensorError::Sample { index, value: image[index] });
-        }
+        check_image(image, width, height)?;
+        let blurred;
+        let image = match &self.airy {
+            Some(a) => {
+                blurred = a.kernel()?.convolve(image, width, height);
+                &blurred
+            }
+            None => image,
+        };
         let levels = f64::from(self.max_count());
         Ok(image
             .iter()
@@ -177,6 +212,19 @@ impl Sensor {
             })
             .collect())
     }
+}
+
+/// Checks that `image` has `width × height > 0` samples, each a finite
+/// intensity ≥ 0.
+pub(crate) fn check_image(image: &[f64], width: usize, height: usize) -> Result<(), SensorError> {
+    let expected = width.checked_mul(height).unwrap_or(0);
+    if expected == 0 || image.len() != expected {
+        return Err(SensorError::ImageSize { expected, found: image.len() });
+    }
+    if let Some(index) = image.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+        return Err(SensorError::Sample { index, value: image[index] });
+    }
+    Ok(())
 }
 
 /// A standard normal variate (Box–Muller).

@@ -169,7 +169,7 @@ pub(crate) fn record<'py>(
     read_noise: f64,
     seed: u64,
 ) -> PyResult<Bound<'py, PyArray2<u16>>> {
-    let sensor = Sensor { exposure, full_well, bits, shot_noise, read_noise };
+    let sensor = Sensor { exposure, full_well, bits, shot_noise, read_noise, airy: None };
     let view = image.as_array();
     let (h, w) = view.dim();
     let data: Vec<f64> = view.iter().copied().collect();
