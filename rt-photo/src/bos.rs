@@ -148,8 +148,14 @@ impl ThinLens {
     /// lens, unit direction toward [`ThinLens::focus_point`].
     #[must_use]
     pub fn ray(&self, px: f64, py: f64, lens: (f64, f64)) -> (DVec3, DVec3) {
+        self.ray_from(px, py, concentric_disk(lens))
+    }
+
+    /// [`ThinLens::ray`] from the lens point `(dx, dy)` of the unit disc
+    /// (along the camera's right and up, in aperture radii).
+    #[must_use]
+    pub fn ray_from(&self, px: f64, py: f64, (dx, dy): (f64, f64)) -> (DVec3, DVec3) {
         let f = self.frame();
-        let (dx, dy) = concentric_disk(lens);
         let r = 0.5 * self.aperture();
         let origin = self.position + r * (dx * f.right + dy * f.up);
         (origin, (self.focus_point_in(&f, px, py) - origin).normalize())

@@ -84,6 +84,7 @@ mod bench;
 mod bos;
 mod cutoff;
 mod film;
+mod focusing;
 mod math;
 mod sensor;
 mod sheet;
@@ -93,6 +94,7 @@ pub use bench::{Bench, BenchError, Mode, Reconstruction, Weighting};
 pub use bos::{Bos, BosError, BosImages, DotBackground, ThinLens};
 pub use cutoff::{Cutoff, CutoffError, CutoffParam, FilterImage};
 pub use film::{Film, FilmError, Filter, Photon};
+pub use focusing::{FocusingError, FocusingImages, FocusingSchlieren, SourceGrid};
 pub use sensor::{Sensor, SensorError};
 // The types in this crate's signatures, from the crates below it (and
 // `build_octree`, the only way to the `Octree` that `render_grid` takes).
