@@ -206,7 +206,7 @@ pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<Bos> {
     let bos = Bos {
         camera,
         background_distance: z_a + z_d,
-        background: DotBackground::for_camera(&camera, a.dot, a.spacing, a.seed),
+        background: DotBackground::for_camera(&camera, a.dot, a.spacing, a.seed).into(),
         aperture_samples: a.samples_per_axis,
         params: TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base },
     };

@@ -8,7 +8,8 @@
 //! *backward* from stratified points of the aperture toward the pixel's
 //! point on the focus plane, through the field (any [`IndexField`], any
 //! integrator), then straight on to the background plane, where the
-//! [`DotBackground`] is looked up. [`Bos::render`] returns the reference
+//! [`Background`] (random dots, a dot grid or an image) is looked up.
+//! [`Bos::render`] returns the reference
 //! image (no flow: the rays go straight), the flow image and the ground
 //! truth users check their BOS processing against: per pixel, the mean
 //! landing point on the background minus the undisturbed one, imaged on
@@ -22,7 +23,8 @@ use rt_core::sampling::{rng_for, uniform_f64};
 use rt_volume::{IndexField, TraceError, TraceParams, trace};
 
 use crate::airy::Airy;
-use crate::math::{cos, floor, sin};
+use crate::background::Background;
+use crate::math::{cos, sin};
 
 /// A thin-lens camera: lens centre `position`, optical axis `direction`,
 /// focused at `focus_distance` (object side) with focal length
@@ -173,57 +175,10 @@ fn concentric_disk((u, v): (f64, f64)) -> (f64, f64) {
     (r * cos(theta), r * sin(theta))
 }
 
-/// A background of random dots: one dot per cell of a square lattice of
-/// `spacing`, at a position drawn from `(seed, cell)`, each a Gaussian of
-/// full width at half maximum `dot_diameter`; the value is the sum of the
-/// dots (bright dots on black, ≤ about 1), on the background plane's `(u,
-/// v)` coordinates.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DotBackground {
-    /// Distance between dots (lattice cell), scene units.
-    pub spacing: f64,
-    /// Dot diameter (full width at half maximum), scene units.
-    pub dot_diameter: f64,
-    /// Seed of the dot positions.
-    pub seed: u64,
-}
-
-impl DotBackground {
-    /// Dots of `dot_px` pixels as imaged, `spacing_px` pixels apart, for
-    /// `camera` focused on the background.
-    #[must_use]
-    pub fn for_camera(camera: &ThinLens, dot_px: f64, spacing_px: f64, seed: u64) -> Self {
-        let px = camera.pixel_in_focus();
-        Self { spacing: spacing_px * px, dot_diameter: dot_px * px, seed }
-    }
-
-    /// The background at `(u, v)`.
-    #[must_use]
-    pub fn value(&self, u: f64, v: f64) -> f64 {
-        let (ci, cj) = (floor(u / self.spacing), floor(v / self.spacing));
-        // Gaussian of FWHM d: exp(−4 ln 2 · r²/d²).
-        let k = 4.0 * core::f64::consts::LN_2 / (self.dot_diameter * self.dot_diameter);
-        let mut sum = 0.0;
-        for dj in -1..=1 {
-            for di in -1..=1 {
-                let (i, j) = (ci + f64::from(di), cj + f64::from(dj));
-                let cell = (i as i64 as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
-                    ^ (j as i64 as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f);
-                let mut rng = rng_for(self.seed, cell);
-                let x = (i + uniform_f64(&mut rng)) * self.spacing;
-                let y = (j + uniform_f64(&mut rng)) * self.spacing;
-                let r2 = (u - x) * (u - x) + (v - y) * (v - y);
-                sum += crate::math::exp(-k * r2);
-            }
-        }
-        sum
-    }
-}
-
 /// A BOS set-up: `camera` focused on the background at `background_distance`
 /// (`Z_B`, normally its focus distance), `aperture_samples²` stratified
 /// rays per pixel.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Bos {
     /// The camera.
     pub camera: ThinLens,
@@ -231,7 +186,7 @@ pub struct Bos {
     /// the optical axis).
     pub background_distance: f64,
     /// The background.
-    pub background: DotBackground,
+    pub background: Background,
     /// `k`: `k × k` stratified aperture (and pixel) samples per pixel.
     pub aperture_samples: u32,
     /// The integrator through the field.
@@ -261,8 +216,25 @@ pub enum BosError {
     /// A camera setting is out of range (which, in words).
     Camera(&'static str),
     /// The background distance is not finite and > 0, or the dots are not
-    /// finite and > 0, or `aperture_samples` is not 1 to 64.
+    /// finite and > 0, or a background image's pixel size is not, or
+    /// `aperture_samples` is not 1 to 64 (which, in words).
     Setup(&'static str),
+    /// A background image has no pixels, or not `width × height` samples.
+    ImageSize {
+        /// Pixels per row.
+        width: usize,
+        /// Rows.
+        height: usize,
+        /// Samples given.
+        samples: usize,
+    },
+    /// A background image's sample is NaN, infinite or negative.
+    ImageSample {
+        /// Its index (row-major).
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
     /// A ray could not be traced through the field.
     Trace(TraceError),
 }
@@ -272,6 +244,13 @@ impl fmt::Display for BosError {
         match self {
             Self::Camera(w) => write!(f, "BOS camera: {w}"),
             Self::Setup(w) => write!(f, "BOS set-up: {w}"),
+            Self::ImageSize { width, height, samples } => write!(
+                f,
+                "BOS background image: {width}×{height} pixels with {samples} samples (must be width × height, not 0)"
+            ),
+            Self::ImageSample { index, value } => {
+                write!(f, "BOS background image: sample {index} is {value}, must be finite and ≥ 0")
+            }
             Self::Trace(e) => write!(f, "BOS trace: {e}"),
         }
     }
@@ -297,9 +276,7 @@ impl Bos {
         if !pos(self.background_distance) {
             return Err(BosError::Setup("the background distance must be finite and > 0"));
         }
-        if !pos(self.background.spacing) || !pos(self.background.dot_diameter) {
-            return Err(BosError::Setup("dot spacing and diameter must be finite and > 0"));
-        }
+        self.background.validate()?;
         if !(1..=64).contains(&self.aperture_samples) {
             return Err(BosError::Setup("aperture samples must be 1 to 64 per axis"));
         }

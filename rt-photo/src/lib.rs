@@ -19,8 +19,8 @@
 //! A [`Sensor`] records an image as a camera would: diffraction blur
 //! ([`Airy`]), exposure, shot and read noise, full well, bit depth.
 //! [`Bos`] renders background-oriented schlieren through a [`ThinLens`]
-//! camera: the reference and flow images of a [`DotBackground`] and the
-//! ground-truth displacement.
+//! camera: the reference and flow images of a [`Background`] (random
+//! dots, a dot grid or an image) and the ground-truth displacement.
 //!
 //! The `rt-volume` types this crate's API takes are re-exported at the
 //! root ([`IndexField`], [`GridField`], [`Octree`], [`TraceParams`], …),
@@ -80,6 +80,7 @@ extern crate alloc;
 extern crate std;
 
 mod airy;
+mod background;
 mod bench;
 mod bos;
 mod cutoff;
@@ -90,8 +91,9 @@ mod sensor;
 mod sheet;
 
 pub use airy::{Airy, AiryKernel};
+pub use background::{Background, DotBackground, DotGrid, ImageBackground};
 pub use bench::{Bench, BenchError, Mode, Reconstruction, Weighting};
-pub use bos::{Bos, BosError, BosImages, DotBackground, ThinLens};
+pub use bos::{Bos, BosError, BosImages, ThinLens};
 pub use cutoff::{Cutoff, CutoffError, CutoffParam, FilterImage};
 pub use film::{Film, FilmError, Filter, Photon};
 pub use focusing::{FocusingError, FocusingImages, FocusingSchlieren, SourceGrid};

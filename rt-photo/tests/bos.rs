@@ -2,7 +2,7 @@
 //! formulas.
 
 use glam::DVec3;
-use rt_photo::{Bos, DotBackground, ThinLens, TraceParams};
+use rt_photo::{Background, Bos, DotBackground, DotGrid, ImageBackground, ThinLens, TraceParams};
 use rt_volume::{Bounds, Constant, GaussianBump};
 
 /// ORACLES §7's camera: f = 0.1 m focused on the background at Z_B = 2.1 m
@@ -21,11 +21,15 @@ fn camera(f_number: f64, width: usize, height: usize) -> ThinLens {
     }
 }
 
+fn dots(cam: &ThinLens) -> DotBackground {
+    DotBackground::for_camera(cam, 3.0, 4.0, 9)
+}
+
 fn bos(cam: ThinLens, k: u32) -> Bos {
     Bos {
         camera: cam,
         background_distance: 2.1,
-        background: DotBackground::for_camera(&cam, 3.0, 4.0, 9),
+        background: dots(&cam).into(),
         aperture_samples: k,
         params: TraceParams::accurate(),
     }
@@ -128,14 +132,19 @@ fn bad_set_ups_are_errors() {
     let f = Constant { n: 1.0, bounds: Bounds::new(DVec3::splat(-1.0), DVec3::splat(1.0)) };
     let good = bos(camera(8.0, 4, 4), 1);
     assert!(good.render(&f, 0).is_ok());
+    let d = dots(&good.camera);
+    let g = DotGrid::for_camera(&good.camera, 2.0, 5.0);
     for bad in [
-        Bos { camera: ThinLens { focus_distance: 0.05, ..good.camera }, ..good },
-        Bos { camera: ThinLens { f_number: f64::NAN, ..good.camera }, ..good },
-        Bos { camera: ThinLens { up: DVec3::Z, ..good.camera }, ..good },
-        Bos { camera: ThinLens { width: 0, ..good.camera }, ..good },
-        Bos { background_distance: -1.0, ..good },
-        Bos { aperture_samples: 0, ..good },
-        Bos { background: DotBackground { spacing: 0.0, ..good.background }, ..good },
+        Bos { camera: ThinLens { focus_distance: 0.05, ..good.camera }, ..good.clone() },
+        Bos { camera: ThinLens { f_number: f64::NAN, ..good.camera }, ..good.clone() },
+        Bos { camera: ThinLens { up: DVec3::Z, ..good.camera }, ..good.clone() },
+        Bos { camera: ThinLens { width: 0, ..good.camera }, ..good.clone() },
+        Bos { background_distance: -1.0, ..good.clone() },
+        Bos { aperture_samples: 0, ..good.clone() },
+        Bos { background: DotBackground { spacing: 0.0, ..d }.into(), ..good.clone() },
+        Bos { background: DotBackground { dot_diameter: f64::NAN, ..d }.into(), ..good.clone() },
+        Bos { background: DotGrid { spacing: -1.0, ..g }.into(), ..good.clone() },
+        Bos { background: DotGrid { dot_diameter: f64::INFINITY, ..g }.into(), ..good.clone() },
     ] {
         let e = bad.render(&f, 0).unwrap_err();
         assert!(!e.to_string().is_empty());
@@ -155,4 +164,166 @@ fn deterministic_across_thread_counts() {
     let one = run(1);
     assert_eq!(one, run(3));
     assert_ne!(one, b.render(&field, 6).unwrap());
+}
+
+/// A flow-free field (n = 1 in a box across the view).
+fn no_flow() -> Constant {
+    Constant { n: 1.0, bounds: Bounds::new(DVec3::new(-0.1, -0.1, 1.0), DVec3::new(0.1, 0.1, 1.2)) }
+}
+
+/// A dot grid 6 pixels apart as imaged: the reference image repeats every
+/// 6 pixels across and down (to the sampling noise of 100 rays a pixel),
+/// and not at half that; the background itself is periodic with its
+/// spacing, with a dot (value ≈ 1) on each lattice point.
+#[test]
+fn dot_grid_is_periodic_with_the_imaged_spacing() {
+    let cam = camera(8.0, 48, 36);
+    let grid = DotGrid::for_camera(&cam, 2.5, 6.0);
+    assert!((grid.spacing - 6.0 * 5e-6 / 0.05).abs() < 1e-15);
+    let s = grid.spacing;
+    for (u, v) in [(0.0, 0.0), (0.31 * s, -0.77 * s), (-4.5 * s, 2.25 * s)] {
+        assert!((grid.value(u + s, v) - grid.value(u, v)).abs() < 1e-12);
+        assert!((grid.value(u, v - 3.0 * s) - grid.value(u, v)).abs() < 1e-12);
+    }
+    assert!((grid.value(2.0 * s, -s) - 1.0).abs() < 1e-3);
+    assert!(grid.value(0.5 * s, 0.5 * s) < 0.01);
+
+    let b = Bos { background: grid.into(), ..bos(cam, 10) };
+    let out = b.render(&no_flow(), 3).unwrap();
+    assert!(out.flow.iter().zip(&out.reference).all(|(a, b)| (a - b).abs() < 1e-9));
+    let (w, h) = (48, 36);
+    let at = |i: usize, j: usize| out.reference[j * w + i];
+    let mut worst: f64 = 0.0;
+    let mut half: f64 = 0.0;
+    for j in 0..h {
+        for i in 0..w {
+            if i + 6 < w {
+                worst = worst.max((at(i + 6, j) - at(i, j)).abs());
+                half = half.max((at(i + 3, j) - at(i, j)).abs());
+            }
+            if j + 6 < h {
+                worst = worst.max((at(i, j + 6) - at(i, j)).abs());
+            }
+        }
+    }
+    let (lo, hi) =
+        out.reference.iter().fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
+    println!(
+        "dot grid: range {lo:.3}..{hi:.3}, period-6 mismatch {worst:.4}, half-period {half:.3}"
+    );
+    assert!(lo < 0.05 && hi > 0.5, "{lo}..{hi}");
+    assert!(worst < 0.02, "not periodic with 6 px: {worst}");
+    assert!(half > 0.3, "{half}");
+}
+
+/// A deterministic pseudo-random image in [0, 1).
+fn noise_image(w: usize, h: usize) -> Vec<f64> {
+    (0..w * h)
+        .map(|p| {
+            let x = (p as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+            ((x >> 11) ^ (x >> 37)) as f64 / (1u64 << 53) as f64 % 1.0
+        })
+        .collect()
+}
+
+/// The camera focused on an image background whose pixels image onto
+/// the sensor's one for one, looking through no flow: the flow image is
+/// the reference, and each pixel is the image's bilinear interpolant
+/// averaged over the pixel, which is the image filtered by
+/// `[1 6 1]/8 ⊗ [1 6 1]/8` (edges repeated), to the sampling noise of 64
+/// rays a pixel; a smooth image comes back as it was.
+#[test]
+fn image_background_is_reproduced_through_a_uniform_field() {
+    let (w, h) = (32usize, 24usize);
+    let cam = camera(8.0, w, h);
+    let img = noise_image(w, h);
+    let background = ImageBackground::for_camera(&cam, w, h, img.clone(), 1.0).unwrap();
+    assert!((background.pixel_size() - 1e-4).abs() < 1e-18);
+    let b = Bos { background: background.into(), ..bos(cam, 8) };
+    let out = b.render(&no_flow(), 4).unwrap();
+    assert!(out.flow.iter().zip(&out.reference).all(|(a, b)| (a - b).abs() < 1e-9));
+    assert!(out.displacement.iter().all(|d| d[0].abs() < 1e-9 && d[1].abs() < 1e-9));
+    let px = |i: isize, j: isize| {
+        img[(j.clamp(0, h as isize - 1) as usize) * w + i.clamp(0, w as isize - 1) as usize]
+    };
+    let tap = [1.0 / 8.0, 6.0 / 8.0, 1.0 / 8.0];
+    let (mut worst, mut raw): (f64, f64) = (0.0, 0.0);
+    for j in 0..h as isize {
+        for i in 0..w as isize {
+            let mut want = 0.0;
+            for (b, ty) in tap.iter().enumerate() {
+                for (a, tx) in tap.iter().enumerate() {
+                    want += tx * ty * px(i + a as isize - 1, j + b as isize - 1);
+                }
+            }
+            let got = out.reference[j as usize * w + i as usize];
+            worst = worst.max((got - want).abs());
+            raw = raw.max((got - px(i, j)).abs());
+        }
+    }
+    println!("image background: max |got − filtered| {worst:.4} (vs unfiltered {raw:.3})");
+    assert!(worst < 0.015, "{worst}");
+    assert!(raw > 0.1, "the filter is real: {raw}");
+
+    // A smooth image (a slow sinusoid) comes back nearly as it was.
+    let smooth: Vec<f64> = (0..w * h)
+        .map(|p| {
+            let (i, j) = ((p % w) as f64, (p / w) as f64);
+            0.5 + 0.4
+                * (core::f64::consts::TAU * i / 32.0).sin()
+                * (core::f64::consts::TAU * j / 24.0).cos()
+        })
+        .collect();
+    let background = ImageBackground::for_camera(&cam, w, h, smooth.clone(), 1.0).unwrap();
+    let out = Bos { background: background.into(), ..bos(cam, 4) }.render(&no_flow(), 4).unwrap();
+    let worst = out.reference.iter().zip(&smooth).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(worst < 0.02, "{worst}");
+}
+
+/// Values of an image background: samples at pixel centres, bilinear
+/// between, the mean outside.
+#[test]
+fn image_background_values() {
+    // 3 × 2 pixels of 0.5 m, centred: x from −0.75 to 0.75, y 0.5 to −0.5.
+    let img = ImageBackground::new(3, 2, vec![0.0, 0.2, 0.4, 1.0, 0.6, 0.8], 0.5).unwrap();
+    assert_eq!((img.width(), img.height(), img.samples().len()), (3, 2, 6));
+    assert!((img.outside() - 0.5).abs() < 1e-15);
+    let b = Background::from(img.clone());
+    assert_eq!(b.value(-0.5, 0.25), 0.0); // pixel (0, 0)'s centre
+    assert_eq!(b.value(0.5, -0.25), 0.8); // pixel (2, 1)'s centre
+    assert!((b.value(-0.25, 0.25) - 0.1).abs() < 1e-15);
+    assert!((b.value(0.0, 0.0) - 0.4).abs() < 1e-15); // (0.2 + 0.6)/2
+    assert_eq!(b.value(-0.7, 0.45), 0.0); // the edge's half pixel repeats it
+    assert_eq!(b.value(-0.8, 0.0), 0.5); // outside: the mean
+    assert_eq!(b.value(0.0, 0.51), 0.5);
+    assert_eq!(b.value(f64::NAN, 0.0), 0.5);
+    assert_eq!(b.value(f64::INFINITY, 0.0), 0.5);
+}
+
+#[test]
+fn bad_background_images_are_errors() {
+    use rt_photo::BosError;
+    let size = |e| matches!(e, Err(BosError::ImageSize { .. }));
+    assert!(size(ImageBackground::new(0, 4, vec![], 1.0)));
+    assert!(size(ImageBackground::new(2, 2, vec![0.5; 3], 1.0)));
+    assert!(size(ImageBackground::new(usize::MAX, 2, vec![0.5; 2], 1.0)));
+    assert!(matches!(
+        ImageBackground::new(2, 1, vec![0.5, f64::NAN], 1.0),
+        Err(BosError::ImageSample { index: 1, .. })
+    ));
+    assert!(matches!(
+        ImageBackground::new(1, 2, vec![-0.1, 0.5], 1.0),
+        Err(BosError::ImageSample { index: 0, value }) if value == -0.1
+    ));
+    assert!(matches!(
+        ImageBackground::new(1, 1, vec![f64::INFINITY], 1.0),
+        Err(BosError::ImageSample { .. })
+    ));
+    for p in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e308] {
+        let e = ImageBackground::new(10, 1, vec![0.5; 10], p).unwrap_err();
+        assert!(matches!(e, BosError::Setup(_)), "{p}: {e}");
+        assert!(!e.to_string().is_empty());
+    }
+    let e = ImageBackground::new(2, 2, vec![0.5; 3], 1.0).unwrap_err();
+    assert!(e.to_string().contains("2×2") && e.to_string().contains('3'), "{e}");
 }
