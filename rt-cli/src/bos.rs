@@ -1,11 +1,16 @@
 //! `rt bos`: background-oriented schlieren of a volume file: the
-//! reference and flow images of a random-dot background seen through the
-//! flow by a thin-lens camera, and the ground-truth displacement.
+//! reference and flow images of a background (random dots, a dot grid or
+//! a PNG image) seen through the flow by a thin-lens camera and recorded
+//! by its sensor (diffraction blur optional), and the ground-truth
+//! displacement.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use rt_photo::{Bos, DotBackground, FilterImage, Sensor, ThinLens, TraceParams};
+use rt_photo::{
+    Background, Bos, DotBackground, DotGrid, FilterImage, ImageBackground, Sensor, ThinLens,
+    TraceParams,
+};
 use rt_volume::{glam::DVec3, io::read_grid};
 
 use crate::{
@@ -46,6 +51,15 @@ pub struct Args {
     /// metres [default: the camera's distance, Z_A].
     #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
     pub background_distance: Option<f64>,
+    /// The background: `random` dots, a `grid` of dots (both sized by
+    /// --dot and --spacing), or the path of a PNG image (grey or colour,
+    /// read as linear luminance: 0 black, 1 white).
+    #[arg(long, default_value = "random", value_parser = background)]
+    pub background: BackgroundChoice,
+    /// A background image's pixel as imaged, in sensor pixels [default:
+    /// the image spans the sensor's width].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub background_pixel: Option<f64>,
     /// Dot diameter on the image, pixels (full width at half maximum).
     #[arg(long, default_value_t = 3.0, value_parser = parse::positive, allow_hyphen_values = true)]
     pub dot: f64,
@@ -71,6 +85,14 @@ pub struct Args {
     /// Read noise, electrons rms.
     #[arg(long, default_value_t = 0.0, value_parser = parse::finite, allow_hyphen_values = true)]
     pub read_noise: f64,
+    /// Diffraction blur: the sensor records the images blurred by the
+    /// lens's Airy pattern (first dark ring 2.44 λ N(1 + M) across, N(1 +
+    /// M) the working f-number).
+    #[arg(long)]
+    pub airy: bool,
+    /// Wavelength in metres (of --airy's diffraction).
+    #[arg(long, default_value_t = 532e-9, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub wavelength: f64,
     /// Seed of the dots, the samples and the noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -112,7 +134,7 @@ pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
         bits: a.bits,
         shot_noise: a.shot_noise,
         read_noise: a.read_noise,
-        airy: None,
+        airy: a.airy.then(|| camera.airy(a.wavelength)),
     };
     let (w32, h32) = (w as u32, h as u32);
     let reference = sensor.record(&images.reference, w, h, a.seed)?;
@@ -147,8 +169,16 @@ pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
     ));
     write_displacement(&raw, &images.displacement, w, h)?;
     let m = camera.magnification();
+    let background = match &a.background {
+        BackgroundChoice::Random => "random dots".to_string(),
+        BackgroundChoice::Grid => "a dot grid".to_string(),
+        BackgroundChoice::Image(p) => p.display().to_string(),
+    };
+    let airy = sensor.airy.map_or(String::new(), |d| {
+        format!("; Airy disc {:.2} px across", 2.0 * d.first_dark_ring())
+    });
     println!(
-        "wrote {}, {}, {}, {} ({w}×{h}, {} rays in {:.2} s; f = {f} m at f/{}, Z_A = {z_a:.3} m, Z_D = {z_d:.3} m, M = {m:.4e}; displacement max {max:.3} px, 99th percentile {p99:.3} px)",
+        "wrote {}, {}, {}, {} ({w}×{h}, {} rays in {:.2} s; f = {f} m at f/{}, Z_A = {z_a:.3} m, Z_D = {z_d:.3} m, M = {m:.4e}; background {background}{airy}; displacement max {max:.3} px, 99th percentile {p99:.3} px)",
         paths[0].display(),
         paths[1].display(),
         paths[2].display(),
@@ -174,11 +204,12 @@ fn axes(axis: Axis) -> (DVec3, DVec3, DVec3) {
 /// the demo and rtvis goes through here): the camera on the +axis side
 /// of the volume's centre looking back along −axis (light travels +axis,
 /// so the image's x runs along u as in `rt schlieren`), focused on the
-/// background `Z_D` behind the centre; dots sized in pixels as imaged;
-/// two-cell leapfrog steps through the field.
+/// background `Z_D` behind the centre; dots sized in pixels as imaged, an
+/// image read from its PNG; two-cell leapfrog steps through the field.
 ///
 /// # Errors
-/// The volume closer to the lens than its focal length, or a bad set-up.
+/// The volume closer to the lens than its focal length, an unreadable
+/// background image, or a bad set-up.
 pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<Bos> {
     let b = volume.field.grid().bounds();
     let (axis, u, v) = axes(a.axis);
@@ -203,15 +234,49 @@ pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<Bos> {
         height: h,
     };
     let base = TraceParams::for_grid(&volume.field);
+    let background: Background = match &a.background {
+        BackgroundChoice::Random => {
+            DotBackground::for_camera(&camera, a.dot, a.spacing, a.seed).into()
+        }
+        BackgroundChoice::Grid => DotGrid::for_camera(&camera, a.dot, a.spacing).into(),
+        BackgroundChoice::Image(path) => {
+            let img = image::read_luminance(path)?;
+            let px = a.background_pixel.unwrap_or(w as f64 / img.width as f64);
+            ImageBackground::for_camera(&camera, img.width, img.height, img.samples, px)
+                .with_context(|| path.display().to_string())?
+                .into()
+        }
+    };
     let bos = Bos {
         camera,
         background_distance: z_a + z_d,
-        background: DotBackground::for_camera(&camera, a.dot, a.spacing, a.seed).into(),
+        background,
         aperture_samples: a.samples_per_axis,
         params: TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base },
     };
     bos.validate()?;
     Ok(bos)
+}
+
+/// What `--background` names.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum BackgroundChoice {
+    /// `random`: random dots.
+    Random,
+    /// `grid`: a regular grid of dots.
+    Grid,
+    /// A PNG image's path.
+    Image(PathBuf),
+}
+
+/// `random`, `grid`, or a path.
+fn background(s: &str) -> Result<BackgroundChoice, String> {
+    Ok(match s {
+        "random" => BackgroundChoice::Random,
+        "grid" => BackgroundChoice::Grid,
+        "" => return Err("`random`, `grid` or the path of a PNG image".into()),
+        path => BackgroundChoice::Image(PathBuf::from(path)),
+    })
 }
 
 /// Writes the displacement as raw little-endian float32 `(Δx, Δy)` per

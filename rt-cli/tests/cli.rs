@@ -409,3 +409,186 @@ fn bos_writes_a_pair_and_its_true_displacement() {
     assert!(help.status.success() && stdout(&help).contains("--background-distance"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A 12-bit sensor PNG's counts (stored in the high bits of 16).
+fn counts12(path: &Path) -> Vec<f64> {
+    let (info, buf) = decode(path);
+    assert_eq!(
+        (info.color_type, info.bit_depth),
+        (png::ColorType::Grayscale, png::BitDepth::Sixteen)
+    );
+    buf.chunks(2).map(|c| f64::from(u16::from_be_bytes([c[0], c[1]]) >> 4)).collect()
+}
+
+/// The sRGB decoding of an 8-bit sample.
+fn srgb_to_linear(c: u8) -> f64 {
+    let c = f64::from(c) / 255.0;
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// `rt bos --background grid|FILE.png` and `--airy`: the grid's reference
+/// repeats every --spacing pixels; a 40 × 40 grey PNG spans the 40-pixel
+/// sensor one pixel for one and comes back (sRGB-decoded, as counts at
+/// 8000 e⁻ of a 10 000 e⁻ well) through no flow, while the flow image
+/// moves it; diffraction lowers the grid's contrast, keeps its mean; the
+/// truth does not depend on the background; bad images are one-line
+/// errors.
+#[test]
+fn bos_backgrounds_grid_image_and_airy() {
+    let dir = scratch("bos-backgrounds");
+    let vol = bump_volume(&dir, false);
+    let run = |stem: &str, extra: &[&str]| {
+        let out = dir.join(format!("{stem}.png"));
+        let mut args = vec![
+            "bos",
+            vol.to_str().unwrap(),
+            "--size",
+            "40",
+            "--samples-per-axis",
+            "6",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = rt(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        for f in ["reference.png", "flow.png", "displacement.png", "displacement.raw"] {
+            assert!(dir.join(format!("{stem}-{f}")).is_file(), "{stem}-{f}");
+        }
+        stdout(&o)
+    };
+    let read = |f: &str| std::fs::read(dir.join(f)).unwrap();
+    run("random", &[]);
+    let said = run("grid", &["--background", "grid", "--spacing", "5", "--dot", "2"]);
+    assert!(said.contains("background a dot grid"), "{said}");
+    let grid = counts12(&dir.join("grid-reference.png"));
+    assert_eq!(grid.len(), 40 * 40);
+    let shift = |v: &[f64], dx: usize, dy: usize| {
+        let mut sum = 0.0;
+        for y in 0..40 - dy {
+            for x in 0..40 - dx {
+                sum += (v[(y + dy) * 40 + x + dx] - v[y * 40 + x]).abs();
+            }
+        }
+        sum / ((40 - dx) * (40 - dy)) as f64
+    };
+    let (period, half) = (shift(&grid, 5, 0) + shift(&grid, 0, 5), shift(&grid, 2, 0));
+    assert!(period < 0.1 * half, "grid period mismatch {period} vs {half}");
+    assert_ne!(read("grid-reference.png"), read("random-reference.png"));
+    assert_eq!(read("grid-displacement.raw"), read("random-displacement.raw"));
+
+    // Diffraction (λN(1 + M) ≈ 1.1 px): the dots spread, the light stays.
+    let said = run(
+        "airy",
+        &[
+            "--background",
+            "grid",
+            "--spacing",
+            "5",
+            "--dot",
+            "2",
+            "--airy",
+            "--f-number",
+            "8",
+            "--pixel",
+            "4e-6",
+        ],
+    );
+    assert!(said.contains("Airy disc"), "{said}");
+    let sharp = run(
+        "sharp",
+        &[
+            "--background",
+            "grid",
+            "--spacing",
+            "5",
+            "--dot",
+            "2",
+            "--f-number",
+            "8",
+            "--pixel",
+            "4e-6",
+        ],
+    );
+    assert!(!sharp.contains("Airy"), "{sharp}");
+    let (a, s) =
+        (counts12(&dir.join("airy-reference.png")), counts12(&dir.join("sharp-reference.png")));
+    let stats = |v: &[f64]| {
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        (m, (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt())
+    };
+    let ((ma, sa), (ms, ss)) = (stats(&a), stats(&s));
+    // (The light the rings carry past an edge is replaced by the clamped
+    // edge's: on 40 pixels the mean moves by under 3 %.)
+    assert!((ma / ms - 1.0).abs() < 0.03, "mean {ma} vs {ms}");
+    assert!(sa < 0.7 * ss, "contrast {sa} vs {ss}");
+    assert_eq!(read("airy-displacement.raw"), read("sharp-displacement.raw"));
+
+    // An image background: vertical stripes 16 pixels apart, 8-bit sRGB.
+    let img = dir.join("stripes.png");
+    let bytes: Vec<u8> = (0..40 * 40)
+        .map(|p| {
+            let x = (p % 40) as f64 + 0.5;
+            (128.0 + 100.0 * (core::f64::consts::TAU * x / 16.0).sin()).round() as u8
+        })
+        .collect();
+    {
+        let f = std::fs::File::create(&img).unwrap();
+        let mut enc = png::Encoder::new(std::io::BufWriter::new(f), 40, 40);
+        enc.set_color(png::ColorType::Grayscale);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.write_header().unwrap().write_image_data(&bytes).unwrap();
+    }
+    let said = run("image", &["--background", img.to_str().unwrap()]);
+    assert!(said.contains("stripes.png"), "{said}");
+    let got = counts12(&dir.join("image-reference.png"));
+    let worst = got
+        .iter()
+        .zip(&bytes)
+        .map(|(&c, &b)| (c / 4095.0 * 10_000.0 / 8000.0 - srgb_to_linear(b)).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 0.03, "image background comes back to {worst}");
+    let flow = counts12(&dir.join("image-flow.png"));
+    let moved = flow.iter().zip(&got).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(moved > 100.0, "the bump moves the stripes: {moved} counts");
+    assert_eq!(read("image-displacement.raw"), read("random-displacement.raw"));
+    // An RGB image is read as its luminance: grey RGB gives the same.
+    let rgb = dir.join("stripes-rgb.png");
+    {
+        let f = std::fs::File::create(&rgb).unwrap();
+        let mut enc = png::Encoder::new(std::io::BufWriter::new(f), 40, 40);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let data: Vec<u8> = bytes.iter().flat_map(|&b| [b, b, b]).collect();
+        enc.write_header().unwrap().write_image_data(&data).unwrap();
+    }
+    run("rgb", &["--background", rgb.to_str().unwrap()]);
+    let grey = counts12(&dir.join("rgb-reference.png"));
+    assert!(grey.iter().zip(&got).all(|(a, b)| (a - b).abs() <= 1.0), "RGB grey ≠ grey");
+
+    // Bad images.
+    std::fs::write(dir.join("junk.png"), b"not a png").unwrap();
+    let bad = |path: &Path| {
+        rt(&[
+            "bos",
+            vol.to_str().unwrap(),
+            "--size",
+            "8",
+            "--background",
+            path.to_str().unwrap(),
+            "--out",
+            dir.join("x.png").to_str().unwrap(),
+        ])
+    };
+    fails_with(&bad(&dir.join("junk.png")), &["junk.png"]);
+    fails_with(&bad(&dir.join("missing.png")), &["missing.png"]);
+    let o = rt(&["bos", vol.to_str().unwrap(), "--background", ""]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let o = rt(&["bos", vol.to_str().unwrap(), "--wavelength", "-1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let help = stdout(&rt(&["bos", "--help"]));
+    for opt in ["--background", "--background-pixel", "--airy", "--wavelength"] {
+        assert!(help.contains(opt), "{opt}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
