@@ -48,7 +48,7 @@ use rt_core::sampling::{rng_for, uniform_f64};
 use rt_volume::{GridField, IndexField, Octree, TraceError, TraceParams, TraceResult, trace};
 
 use crate::bos::{Frame, ThinLens};
-use crate::math::{cos, floor, sin, sqrt};
+use crate::math::{atan2, cos, floor, sin, sqrt};
 
 /// The source grid: bright bands of width `duty · pitch`, `pitch` apart,
 /// on the source plane. `angle` turns the bands: at 0 they run along the
@@ -78,29 +78,85 @@ impl SourceGrid {
         u * cos(self.angle) + v * sin(self.angle)
     }
 
-    /// Whether `s` (across the bands) lies on a bright band.
-    fn bright(&self, s: f64) -> bool {
+    /// `s` (across the bands) in period units: band `k` is bright on
+    /// `y ∈ [k + (1 − d)/2, k + (1 + d)/2)`, `d` the duty cycle.
+    fn y(&self, s: f64) -> f64 {
         let c = match self.bands {
             Some(n) if n % 2 == 0 => 0.5,
             _ => 0.0,
         };
-        let x = s / self.pitch - c;
-        let k = floor(x + 0.5);
-        if let Some(n) = self.bands {
-            // Bands k = −(n−1)/2 … (n−1)/2 (shifted by c for even n).
-            let half = (f64::from(n) - 1.0) / 2.0;
-            if (k + c).abs() > half + 1e-9 {
-                return false;
+        s / self.pitch - c + 0.5
+    }
+
+    /// The periods `[lo, hi)` (in `y`) that hold bands: all, or `n` of
+    /// them centred on the axis.
+    fn period_range(&self) -> (f64, f64) {
+        match self.bands {
+            None => (f64::NEG_INFINITY, f64::INFINITY),
+            Some(n) => {
+                let lo = -f64::from(n / 2);
+                (lo, lo + f64::from(n))
             }
         }
-        (x - k).abs() < 0.5 * self.duty
+    }
+
+    /// Whether `s` (across the bands) lies on a bright band.
+    #[cfg(test)]
+    fn bright(&self, s: f64) -> bool {
+        let y = self.y(s);
+        let (lo, hi) = self.period_range();
+        let f = y - floor(y);
+        y >= lo && y < hi && f >= 0.5 * (1.0 - self.duty) && f < 0.5 * (1.0 + self.duty)
+    }
+
+    /// `∫ B(s) ds` over `[s0, s1]`: the bright length there.
+    fn bright_length(&self, s0: f64, s1: f64) -> f64 {
+        let (lo, hi) = self.period_range();
+        let (y0, y1) = (self.y(s0).max(lo), self.y(s1).min(hi));
+        if y1 <= y0 {
+            return 0.0;
+        }
+        // Cumulative bright length in periods, from y = 0.
+        let (a, d) = (0.5 * (1.0 - self.duty), self.duty);
+        let cumulative = |y: f64| {
+            let k = floor(y);
+            k * d + (y - k - a).clamp(0.0, d)
+        };
+        (cumulative(y1) - cumulative(y0)) * self.pitch
+    }
+
+    /// `∫ B(s)·B(s + shift) ds` over `[s0, s1]`: the length lit by the
+    /// grid and by the grid moved by `−shift`.
+    fn overlap_length(&self, s0: f64, s1: f64, shift: f64) -> f64 {
+        let (lo, hi) = self.period_range();
+        let e = shift / self.pitch;
+        // Both factors hold bands only where `y` and `y + e` lie in the
+        // band periods; there they equal the unbounded grid's.
+        let y0 = self.y(s0).max(lo).max(lo - e);
+        let y1 = self.y(s1).min(hi).min(hi - e);
+        if !(y1 > y0) {
+            return 0.0;
+        }
+        let (a, b) = (0.5 * (1.0 - self.duty), 0.5 * (1.0 + self.duty));
+        let e = e - floor(e);
+        let meet = |p: f64, q: f64, r: f64, t: f64| (q.min(t) - p.max(r)).max(0.0);
+        // In one period u ∈ [0, 1): B(u) on [a, b); B(u + e) on
+        // [a − e, b − e) and [a − e + 1, b − e + 1).
+        let within =
+            |f: f64| meet(a, b.min(f), a - e, b - e) + meet(a, b.min(f), a - e + 1.0, b - e + 1.0);
+        let per_period = within(1.0);
+        let cumulative = |y: f64| {
+            let k = floor(y);
+            k * per_period + within(y - k)
+        };
+        (cumulative(y1) - cumulative(y0)) * self.pitch
     }
 }
 
 /// A focusing-schlieren set-up (see the module docs): `camera` focused on
 /// the plane of the flow to image, the source grid at `source_distance`
 /// from the lens (behind the flow), the cutoff grid its negative shifted by
-/// `cutoff_offset` pitches, `aperture_samples²` stratified rays per pixel.
+/// `cutoff_offset` pitches, `aperture_samples²` rays per pixel.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FocusingSchlieren {
     /// The camera: its lens is the schlieren lens, its focus distance the
@@ -114,7 +170,8 @@ pub struct FocusingSchlieren {
     /// sensitivity. In `(0, min(duty, 1 − duty)]` the undisturbed image
     /// passes `o/p` of the light; 0 is dark field.
     pub cutoff_offset: f64,
-    /// `k`: `k × k` stratified aperture (and pixel) samples per pixel.
+    /// `k`: `k` stratified points per pixel, each seeing the aperture
+    /// through `k` stripes along the bands (`k²` traced rays per pixel).
     pub aperture_samples: u32,
     /// The integrator through the field.
     pub params: TraceParams,
@@ -212,10 +269,20 @@ impl FocusingSchlieren {
         why.map_or(Ok(()), |w| Err(FocusingError::Setup(w)))
     }
 
-    /// The cutoff's transmission at `s` (across the bands, source-plane
-    /// units): the negative of the source grid, shifted by the offset.
-    fn cutoff(&self, s: f64) -> f64 {
-        if self.grid.bright(s - self.cutoff_offset * self.grid.pitch) { 0.0 } else { 1.0 }
+    /// The light through the cutoff from the source-plane interval
+    /// `[s0, s1]` (across the bands) whose rays the flow moves by `shift`
+    /// there: `∫ B(s + shift)·C(s) ds` with `C(s) = 1 − B(s − o)`.
+    fn transmitted(&self, s0: f64, s1: f64, shift: f64) -> f64 {
+        let o = self.cutoff_offset * self.grid.pitch;
+        let lit = self.grid.bright_length(s0 + shift, s1 + shift);
+        // ∫ B(s + shift)·B(s − o) ds = ∫ B(t)·B(t + shift + o) dt, t = s − o.
+        (lit - self.grid.overlap_length(s0 - o, s1 - o, shift + o)).max(0.0)
+    }
+
+    /// The length of `[s0, s1]` the cutoff passes: `∫ C(s) ds`.
+    fn open_length(&self, s0: f64, s1: f64) -> f64 {
+        let o = self.cutoff_offset * self.grid.pitch;
+        (s1 - s0) - self.grid.bright_length(s0 - o, s1 - o)
     }
 
     /// The smallest deflection (radians) the set-up resolves: the one
@@ -314,13 +381,19 @@ impl FocusingSchlieren {
 
     /// One row's `[reference, flow]` pixels.
     ///
-    /// The aperture is sampled in `k²` stripes along the bands (jittered
-    /// across them; uniform along, weighted by the stripe's chord): the
-    /// light a ray carries depends on where it crosses the bands, so the
-    /// bands' edges are resolved to `1/k²` of the aperture — far better
-    /// than a `k × k` lattice of points, whose cells are wider than a
-    /// fine grid's bands. Pixel positions are stratified `k × k` in an
-    /// order decorrelated from the stripes.
+    /// Each pixel is sampled at `k` stratified points (a jittered Latin
+    /// square of `k × k` cells), and from each the aperture is cut in `k`
+    /// stripes along the bands, one traced ray per stripe from a jittered
+    /// point of it. The light a ray carries depends only on where it
+    /// crosses the bands, so a stripe's is integrated exactly across it:
+    /// its lens interval maps onto an interval `[s₀⁻, s₀⁺]` of the source
+    /// plane (the undisturbed lines), which the flow moves by the traced
+    /// ray's `s₁ − s₀`; the stripe carries `∫ B(s + s₁ − s₀)·C(s) ds` over
+    /// it, in pieces (64 over the aperture) weighted by their exact areas.
+    /// Without the flow, or with a disturbance in the focus plane (every
+    /// ray of a point moved alike), this is exact whatever the bands'
+    /// pitch; elsewhere it holds while the flow's shift varies little
+    /// across a stripe. No grain from bands finer than the samples.
     fn row(
         &self,
         tracer: &impl Fn(DVec3, DVec3) -> Result<TraceResult, TraceError>,
@@ -330,46 +403,67 @@ impl FocusingSchlieren {
     ) -> Result<Vec<[f64; 2]>, FocusingError> {
         let cam = &self.camera;
         let k = self.aperture_samples;
-        let n = k * k;
-        let scramble = coprime_near(n, 0.618_033_988_75 * f64::from(n));
+        let kf = f64::from(k);
+        let scramble = coprime_near(k, 0.618_033_988_75 * kf);
         let (across, along) = (
             (cos(self.grid.angle), sin(self.grid.angle)),
             (-sin(self.grid.angle), cos(self.grid.angle)),
         );
+        // ds₀/da: the undisturbed line through lens point a (aperture
+        // radii, across) and a fixed focus point meets the source plane
+        // at s₀ = a·R·(1 − Z_S/Z_F) + const.
+        let slope = 0.5 * cam.aperture() * (1.0 - self.source_distance / cam.focus_distance);
+        let width = 2.0 / kf;
+        let parts = 64u32.div_ceil(k);
+        let piece = width / f64::from(parts);
         let mut out = Vec::with_capacity(cam.width);
         for i in 0..cam.width {
             let mut rng = rng_for(seed, (j * cam.width + i) as u64);
-            let (mut reference, mut flow, mut total) = (0.0, 0.0, 0.0);
-            for s in 0..n {
-                let a = 2.0 * (f64::from(s) + uniform_f64(&mut rng)) / f64::from(n) - 1.0;
-                let chord = sqrt((1.0 - a * a).max(0.0));
-                let b = (2.0 * uniform_f64(&mut rng) - 1.0) * chord;
-                let lens = (a * across.0 + b * along.0, a * across.1 + b * along.1);
-                let p = (u64::from(s) * u64::from(scramble) % u64::from(n)) as u32;
-                let sub = (
-                    (f64::from(p % k) + uniform_f64(&mut rng)) / f64::from(k),
-                    (f64::from(p / k) + uniform_f64(&mut rng)) / f64::from(k),
-                );
-                total += chord;
-                let (o, d) = cam.ray_from(i as f64 + sub.0, j as f64 + sub.1, lens);
-                let s0 = self.on_source(f, o, d);
-                let cut = self.cutoff(s0);
-                if cut == 0.0 {
-                    // Blocked whatever the flow does to it: no trace.
-                    continue;
-                }
-                if self.grid.bright(s0) {
-                    reference += cut * chord;
-                }
-                let r = tracer(o, d).map_err(FocusingError::Trace)?;
-                if self.grid.bright(self.on_source(f, r.position, r.direction)) {
-                    flow += cut * chord;
+            let (mut reference, mut flow) = (0.0, 0.0);
+            for q in 0..k {
+                let row = (u64::from(q) * u64::from(scramble) % u64::from(k)) as u32;
+                let px = i as f64 + (f64::from(q) + uniform_f64(&mut rng)) / kf;
+                let py = j as f64 + (f64::from(row) + uniform_f64(&mut rng)) / kf;
+                for t in 0..k {
+                    let a0 = f64::from(t) * width - 1.0;
+                    let a = a0 + uniform_f64(&mut rng) * width;
+                    let b = (2.0 * uniform_f64(&mut rng) - 1.0) * sqrt((1.0 - a * a).max(0.0));
+                    let lens = (a * across.0 + b * along.0, a * across.1 + b * along.1);
+                    let (o, d) = cam.ray_from(px, py, lens);
+                    let s0 = self.on_source(f, o, d);
+                    // The stripe's pieces: their intervals on the source
+                    // plane and their shares of the aperture.
+                    let pieces = (0..parts).map(|m| {
+                        let (p0, p1) = (a0 + f64::from(m) * piece, a0 + f64::from(m + 1) * piece);
+                        let (e0, e1) = (s0 + (p0 - a) * slope, s0 + (p1 - a) * slope);
+                        let area = disc_area_below(p1) - disc_area_below(p0);
+                        (e0.min(e1), e0.max(e1), area / (piece * slope.abs()))
+                    });
+                    if pieces.clone().all(|(lo, hi, _)| self.open_length(lo, hi) <= 0.0) {
+                        // Blocked whatever the flow does to it: no trace.
+                        continue;
+                    }
+                    let r = tracer(o, d).map_err(FocusingError::Trace)?;
+                    let shift = self.on_source(f, r.position, r.direction) - s0;
+                    for (lo, hi, weight) in pieces {
+                        reference += weight * self.transmitted(lo, hi, 0.0);
+                        flow += weight * self.transmitted(lo, hi, shift);
+                    }
                 }
             }
+            // Each of the k points saw the whole aperture, area π.
+            let total = kf * core::f64::consts::PI;
             out.push([reference / total, flow / total]);
         }
         Ok(out)
     }
+}
+
+/// The area of the unit disc left of `a` (`∫ 2√(1 − t²) dt` from −1).
+fn disc_area_below(a: f64) -> f64 {
+    let a = a.clamp(-1.0, 1.0);
+    let c = sqrt((1.0 - a * a).max(0.0));
+    a * c + atan2(a, c) + core::f64::consts::FRAC_PI_2
 }
 
 /// The integer nearest `target` (in `[1, n)`) that is coprime to `n`: `s ↦
@@ -386,4 +480,43 @@ fn coprime_near(n: u32, target: f64) -> u32 {
         m += 1;
     }
     m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The closed-form lengths against a fine Riemann sum of the bands,
+    /// for unbounded and finite grids, odd and even band counts, shifts
+    /// of any size and intervals across many periods or inside one.
+    #[test]
+    fn band_integrals_are_the_sums_of_the_bands() {
+        let riemann = |f: &dyn Fn(f64) -> f64, s0: f64, s1: f64| {
+            let m = 200_000;
+            let h = (s1 - s0) / f64::from(m);
+            (0..m).map(|i| f(s0 + (f64::from(i) + 0.5) * h)).sum::<f64>() * h
+        };
+        let b = |g: &SourceGrid, s: f64| if g.bright(s) { 1.0 } else { 0.0 };
+        for bands in [None, Some(1), Some(2), Some(5)] {
+            for duty in [0.2, 0.5, 0.8] {
+                let g = SourceGrid { pitch: 0.7, duty, angle: 0.0, bands };
+                for (s0, s1) in [(-3.1, 2.9), (0.05, 0.31), (-0.4, -0.1), (1.2, 9.0)] {
+                    let want = riemann(&|s| b(&g, s), s0, s1);
+                    let got = g.bright_length(s0, s1);
+                    assert!(
+                        (got - want).abs() < 1e-4,
+                        "{bands:?} {duty} [{s0}, {s1}]: {got} vs {want}"
+                    );
+                    for shift in [0.0, 0.13, -0.52, 0.7, 2.35] {
+                        let want = riemann(&|s| b(&g, s) * b(&g, s + shift), s0, s1);
+                        let got = g.overlap_length(s0, s1, shift);
+                        assert!(
+                            (got - want).abs() < 1e-4,
+                            "{bands:?} {duty} [{s0}, {s1}] shift {shift}: {got} vs {want}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 }
