@@ -15,7 +15,7 @@ use rt_cli::{
     optics::{Axis, Interpolation, Quantity, Samples},
     schlieren::{Args, CutoffKind, Estimator, prepare},
 };
-use rt_photo::{Bench, Mode, Reconstruction, Sensor};
+use rt_photo::{Airy, Bench, ImageBackground, Mode, Reconstruction, Sensor};
 use rt_volume::GLADSTONE_DALE_AIR;
 
 use crate::{value_error, volume::PyVolume};
@@ -154,10 +154,11 @@ pub(crate) fn optics<'py>(
 }
 
 /// Records an intensity image (1 = background) as a camera sensor would
-/// (`rt_photo::Sensor`): counts of `bits` bits.
+/// (`rt_photo::Sensor`): counts of `bits` bits; `airy` = `(wavelength,
+/// f-number, pixel pitch)` blurs it by diffraction first.
 #[pyfunction]
 #[pyo3(name = "_record")]
-#[pyo3(signature = (image, exposure, full_well, bits, shot_noise, read_noise, seed))]
+#[pyo3(signature = (image, exposure, full_well, bits, shot_noise, read_noise, seed, airy=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn record<'py>(
     py: Python<'py>,
@@ -168,8 +169,10 @@ pub(crate) fn record<'py>(
     shot_noise: bool,
     read_noise: f64,
     seed: u64,
+    airy: Option<(f64, f64, f64)>,
 ) -> PyResult<Bound<'py, PyArray2<u16>>> {
-    let sensor = Sensor { exposure, full_well, bits, shot_noise, read_noise, airy: None };
+    let airy = airy.map(|(wavelength, f_number, pitch)| Airy::new(wavelength, f_number, pitch));
+    let sensor = Sensor { exposure, full_well, bits, shot_noise, read_noise, airy };
     let view = image.as_array();
     let (h, w) = view.dim();
     let data: Vec<f64> = view.iter().copied().collect();
@@ -183,21 +186,36 @@ type BosOut<'py> =
     (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>, String);
 
 /// Background-oriented schlieren of `volume`, set up by `rt bos`'s own
-/// options (`args`: its command-line arguments after the file).
+/// options (`args`: its command-line arguments after the file); `image`
+/// (grey, row 0 at the top) replaces the background, each of its pixels
+/// `image_pixel` sensor pixels as imaged (default: it spans the width).
 #[pyfunction]
 #[pyo3(name = "_bos")]
+#[pyo3(signature = (volume, args, image=None, image_pixel=None))]
 pub(crate) fn bos<'py>(
     py: Python<'py>,
     volume: &PyVolume,
     args: Vec<String>,
+    image: Option<PyReadonlyArray2<'py, f64>>,
+    image_pixel: Option<f64>,
 ) -> PyResult<BosOut<'py>> {
     let a = rt_cli::bos::Args::from_args(std::path::Path::new("volume"), args).map_err(|e| {
         value_error(e.to_string().lines().next().unwrap_or_default().trim_start_matches("error: "))
     })?;
     let v = &volume.inner;
+    let image = image.map(|i| {
+        let view = i.as_array();
+        let (h, w) = view.dim();
+        (w, h, view.iter().copied().collect::<Vec<f64>>())
+    });
     let (bos, images) = py
         .detach(|| -> anyhow::Result<_> {
-            let bos = rt_cli::bos::prepare(v, &a)?;
+            let mut bos = rt_cli::bos::prepare(v, &a)?;
+            if let Some((w, h, samples)) = image {
+                let px = image_pixel.unwrap_or(bos.camera.width as f64 / w as f64);
+                bos.background =
+                    ImageBackground::for_camera(&bos.camera, w, h, samples, px)?.into();
+            }
             let images = bos.render(&v.field, a.seed)?;
             Ok((bos, images))
         })
@@ -205,9 +223,10 @@ pub(crate) fn bos<'py>(
     let (w, h) = (images.width, images.height);
     let c = bos.camera;
     let said = format!(
-        "f = {} m at f/{}, Z_A = {:.4} m, Z_B = {:.4} m, M = {:.4e}, {}×{} pixels of {} m",
+        "f = {} m at f/{} (working f/{:.4}), Z_A = {:.4} m, Z_B = {:.4} m, M = {:.4e}, {}×{} pixels of {} m",
         c.focal_length,
         c.f_number,
+        c.f_number * (1.0 + c.magnification()),
         a.distance_or_default(v),
         bos.background_distance,
         c.magnification(),

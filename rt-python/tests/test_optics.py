@@ -221,3 +221,51 @@ def test_bos_displacement_is_the_paraxial_relation(gaussian):
         rtvis.bos(vol, distance=0.05)
     with pytest.raises(ValueError, match="f_number must be > 0"):
         rtvis.bos(vol, f_number=-1)
+
+
+def test_bos_backgrounds_and_diffraction(tmp_path):
+    flat = rtvis.Volume(np.full((8, 8, 8), 1.0), quantity="index", spacing=(1e-3,) * 3)
+    # A dot grid 6 pixels apart as imaged repeats every 6 pixels, not 3.
+    grid, flow, _, info = rtvis.bos(flat, size=48, background="grid", dot=2.5, spacing=6.0, samples=8)
+    assert grid.shape == (48, 48) and np.abs(flow - grid).max() < 1e-9
+    assert np.abs(grid[:, 6:] - grid[:, :-6]).max() < 0.02
+    assert np.abs(grid[6:] - grid[:-6]).max() < 0.02
+    assert np.abs(grid[:, 3:] - grid[:, :-3]).max() > 0.3
+    assert "working f/" in info
+    # A smooth grey array imaged pixel for pixel comes back through no flow.
+    y, x = np.mgrid[0:48, 0:48] + 0.5
+    img = 0.5 + 0.4 * np.sin(2 * np.pi * x / 32) * np.cos(2 * np.pi * y / 24)
+    ref, flow, disp, _ = rtvis.bos(flat, size=48, background=img, samples=4)
+    assert np.abs(ref - img).max() < 0.02 and np.abs(flow - ref).max() < 1e-9
+    assert np.abs(disp).max() < 1e-9
+    # Half as many pixels, each 2 sensor pixels wide: the same picture.
+    half = rtvis.bos(flat, size=48, background=img[::2, ::2], background_pixel=2.0, samples=4)[0]
+    assert np.abs(half - img).max() < 0.1
+    # The same image as an 8-bit PNG, read as linear luminance (sRGB decoded).
+    g8 = np.round(img * 255).astype(np.uint8)
+    rtvis.save_png(tmp_path / "bg.png", g8)
+    c = g8 / 255.0
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    from_png = rtvis.bos(flat, size=48, background=str(tmp_path / "bg.png"), samples=4)[0]
+    assert np.abs(from_png - rtvis.bos(flat, size=48, background=lin, samples=4)[0]).max() < 1e-12
+    # Diffraction at the sensor: the grid's contrast drops, its light stays.
+    sharp = rtvis.record(grid, exposure=8000.0, full_well=20000.0).astype(float)
+    soft = rtvis.record(grid, exposure=8000.0, full_well=20000.0, airy=(532e-9, 16.0, 5e-6)).astype(float)
+    assert soft.std() < 0.8 * sharp.std()
+    assert abs(soft.mean() / sharp.mean() - 1.0) < 0.03
+    # Bad input.
+    with pytest.raises(ValueError, match="negative"):
+        rtvis.bos(flat, size=8, background=-np.ones((4, 4)))
+    with pytest.raises(ValueError, match="not finite"):
+        rtvis.bos(flat, size=8, background=np.full((4, 4), np.nan))
+    (tmp_path / "junk.png").write_bytes(b"not a png")
+    with pytest.raises(ValueError, match="junk.png"):
+        rtvis.bos(flat, size=8, background=str(tmp_path / "junk.png"))
+    with pytest.raises(ValueError, match="background_pixel must be > 0"):
+        rtvis.bos(flat, size=8, background=img, background_pixel=0.0)
+    with pytest.raises(ValueError, match="airy pixel must be > 0"):
+        rtvis.record(grid, airy=(532e-9, 16.0, 0.0))
+    with pytest.raises(TypeError, match="airy"):
+        rtvis.record(grid, airy=1.0)
+    with pytest.raises(ValueError, match="λN"):
+        rtvis.record(grid, airy=(532e-9, 1000.0, 1e-6))

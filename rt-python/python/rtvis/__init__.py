@@ -22,6 +22,7 @@ NaN, out of range, unknown option), never crashes the interpreter.
 from __future__ import annotations
 
 import math
+import os
 import struct
 import time
 import zlib
@@ -451,22 +452,33 @@ def color_schlieren(
 def bos(volume: Volume, axis: str = "z", size: int = 512, focal_length: float = 0.1,
         f_number: float = 16.0, pixel: float = 5e-6, distance: Optional[float] = None,
         background_distance: Optional[float] = None, dot: float = 3.0, spacing: float = 4.0,
-        samples: int = 2, seed: int = 1):
+        samples: int = 2, seed: int = 1, background="random",
+        background_pixel: Optional[float] = None):
     """Background-oriented schlieren of ``volume``, set up as ``rt bos``
     sets it up: a thin-lens camera (``focal_length`` and ``pixel`` pitch in
     metres, ``f_number``) at ``distance`` Z_A from the volume's centre on
     the +``axis`` side (default: the volume fills the image width), focused
-    on a random-dot background ``background_distance`` Z_D behind the
-    centre (default Z_A); dots of ``dot`` pixels ``spacing`` pixels apart
-    as imaged; ``samples``² stratified aperture samples per pixel traced
+    on a background ``background_distance`` Z_D behind the centre (default
+    Z_A); ``samples``² stratified aperture samples per pixel traced
     backward through the field.
+
+    ``background``: ``"random"`` dots or a ``"grid"`` of dots (both
+    ``dot`` pixels wide, ``spacing`` pixels apart as imaged), the path of a
+    PNG image (grey or colour, read as linear luminance, as ``rt bos
+    --background FILE``), or a 2-D array of grey values ≥ 0 (1 = white,
+    row 0 at the top). An image is centred on the optical axis, each of
+    its pixels ``background_pixel`` sensor pixels as imaged (default: it
+    spans the image width); outside it the background is its mean.
 
     Returns ``(reference, flow, displacement, info)``: the background
     without and with the flow (float64 (h, w), about 0–1; record them with
-    :func:`record` for a camera's counts and noise), the ground-truth
-    displacement of the background's image, float64 (h, w, 2) in pixels
-    (x right, y down), and a line describing the set-up. Paraxially
-    ``|Δ| = M·Z_D·|ε|/pitch``, ``M = f/(Z_A + Z_D − f)``.
+    :func:`record` for a camera's counts, noise and diffraction), the
+    ground-truth displacement of the background's image, float64 (h, w, 2)
+    in pixels (x right, y down), and a line describing the set-up (with the
+    working f-number ``N·(1 + M)`` that :func:`record`'s ``airy`` wants).
+    Paraxially ``|Δ| = M·Z_D·|ε|/pitch``, ``M = f/(Z_A + Z_D − f)``.
+
+    Example: ``ref, flow, disp, info = rtvis.bos(vol, background="grid")``.
     """
     if not isinstance(volume, Volume):
         raise TypeError(f"volume: expected an rtvis.Volume, got {type(volume).__name__}")
@@ -483,11 +495,26 @@ def bos(volume: Volume, axis: str = "z", size: int = 512, focal_length: float = 
         args += ["--distance", repr(_number("distance", distance, positive=True))]
     if background_distance is not None:
         args += ["--background-distance", repr(_number("background_distance", background_distance, positive=True))]
-    return _rtvis._bos(volume._v, args)
+    image = None
+    if isinstance(background, (str, os.PathLike)):
+        name = os.fspath(background)
+        if name == "":
+            raise ValueError("background: \"random\", \"grid\", the path of a PNG image or a 2-D array")
+        args += ["--background", name]
+    else:
+        image = _array("background", background, 2, np.float64)
+        if (image < 0).any():
+            where = tuple(int(i) for i in np.argwhere(image < 0)[0])
+            raise ValueError(f"background: value at {where} is negative ({image[where]})")
+    pixel_px = _number("background_pixel", background_pixel, positive=True, optional=True)
+    if pixel_px is not None and image is None:
+        args += ["--background-pixel", repr(pixel_px)]
+    return _rtvis._bos(volume._v, args, image, pixel_px)
 
 
 def record(image, exposure: float = 10_000.0, full_well: float = 20_000.0, bits: int = 16,
-           shot_noise: bool = False, read_noise: float = 0.0, seed: int = 0) -> np.ndarray:
+           shot_noise: bool = False, read_noise: float = 0.0, seed: int = 0,
+           airy: Optional[Tuple[float, float, float]] = None) -> np.ndarray:
     """Records an optics image as a camera sensor would: a pixel of
     intensity ``I`` (1 = background) collects ``exposure·I`` electrons on
     average; with ``shot_noise`` the count is Poisson, plus Gaussian
@@ -497,16 +524,33 @@ def record(image, exposure: float = 10_000.0, full_well: float = 20_000.0, bits:
     pixel's noise is its own stream); record a reference and a flow image
     with different seeds for independent noise. Noise is off by default.
 
+    ``airy = (wavelength, f_number, pixel)`` (metres, the f-number of the
+    light converging on the sensor — for a lens focused at magnification
+    ``M``, ``N·(1 + M)`` — and the pixel pitch in metres) first blurs the
+    image by the lens's diffraction: an Airy pattern whose first dark ring
+    is ``2.44·wavelength·f_number`` across, integrated over each pixel,
+    edges clamped. Off by default.
+
     Example: ``rtvis.record(rtvis.schlieren(vol), exposure=5000,
-    full_well=10000, bits=12, shot_noise=True, read_noise=5, seed=1)``.
+    full_well=10000, bits=12, shot_noise=True, read_noise=5, seed=1)``;
+    ``rtvis.record(ref, airy=(532e-9, 16.8, 5e-6))``.
     """
     a = _array("image", image, 2, np.float64)
     if (a < 0).any():
         where = tuple(int(i) for i in np.argwhere(a < 0)[0])
         raise ValueError(f"image: intensity at {where} is negative ({a[where]})")
+    diffraction = None
+    if airy is not None:
+        try:
+            wavelength, f_number, pitch = airy
+        except (TypeError, ValueError):
+            raise TypeError("airy: expected (wavelength, f_number, pixel)") from None
+        diffraction = (_number("airy wavelength", wavelength, positive=True),
+                       _number("airy f_number", f_number, positive=True),
+                       _number("airy pixel", pitch, positive=True))
     return _rtvis._record(a, _number("exposure", exposure), _number("full_well", full_well, positive=True),
                           _integer("bits", bits, 1, 16), bool(shot_noise), _number("read_noise", read_noise),
-                          _integer("seed", seed, 0, 2**64 - 1))
+                          _integer("seed", seed, 0, 2**64 - 1), diffraction)
 
 
 class Camera:
