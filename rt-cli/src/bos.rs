@@ -11,7 +11,7 @@ use rt_photo::{
     Background, Bos, DotBackground, DotGrid, FilterImage, ImageBackground, Sensor, ThinLens,
     TraceParams,
 };
-use rt_volume::{glam::DVec3, io::read_grid};
+use rt_volume::io::read_grid;
 
 use crate::{
     image,
@@ -167,7 +167,15 @@ pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
         "{}-displacement.raw",
         a.out.file_stem().map_or("bos".into(), |s| s.to_string_lossy())
     ));
-    write_displacement(&raw, &images.displacement, w, h)?;
+    let flat: Vec<f64> = images.displacement.iter().flatten().copied().collect();
+    image::write_raw_f32(
+        &raw,
+        &flat,
+        2,
+        w,
+        h,
+        "BOS ground-truth displacement (dx, dy) per pixel, in pixels, x right and y down, rows top first",
+    )?;
     let m = camera.magnification();
     let background = match &a.background {
         BackgroundChoice::Random => "random dots".to_string(),
@@ -190,16 +198,6 @@ pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The beam axis and the image's u and v axes (as `rt schlieren`'s).
-fn axes(axis: Axis) -> (DVec3, DVec3, DVec3) {
-    let (d, u) = match axis {
-        Axis::X => (DVec3::X, DVec3::Y),
-        Axis::Y => (DVec3::Y, DVec3::Z),
-        Axis::Z => (DVec3::Z, DVec3::X),
-    };
-    (d, u, d.cross(u))
-}
-
 /// The BOS set-up `a` describes for `volume` (every render of `rt bos`,
 /// the demo and rtvis goes through here): the camera on the +axis side
 /// of the volume's centre looking back along −axis (light travels +axis,
@@ -212,7 +210,8 @@ fn axes(axis: Axis) -> (DVec3, DVec3, DVec3) {
 /// background image, or a bad set-up.
 pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<Bos> {
     let b = volume.field.grid().bounds();
-    let (axis, u, v) = axes(a.axis);
+    let (axis, u) = a.axis.frame();
+    let v = axis.cross(u);
     let ext = b.max - b.min;
     let w = a.size as usize;
     let h = ((f64::from(a.size) * ext.dot(v) / ext.dot(u)).round() as usize).max(1);
@@ -279,36 +278,13 @@ fn background(s: &str) -> Result<BackgroundChoice, String> {
     })
 }
 
-/// Writes the displacement as raw little-endian float32 `(Δx, Δy)` per
-/// pixel with a JSON sidecar (`rt`'s raw + JSON format, two components).
-fn write_displacement(raw: &Path, d: &[[f64; 2]], w: usize, h: usize) -> anyhow::Result<()> {
-    if let Some(dir) = raw.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
-    }
-    let bytes: Vec<u8> =
-        d.iter().flat_map(|p| p.map(|x| x as f32)).flat_map(f32::to_le_bytes).collect();
-    std::fs::write(raw, bytes).with_context(|| raw.display().to_string())?;
-    let json = serde_json::json!({
-        "dims": [w, h],
-        "components": 2,
-        "dtype": "float32",
-        "endian": "little",
-        "file": raw.file_name().map(|f| f.to_string_lossy().into_owned()),
-        "description": "BOS ground-truth displacement (dx, dy) per pixel, in pixels, x right and y down, rows top first",
-    });
-    let path = raw.with_extension("json");
-    std::fs::write(&path, serde_json::to_string_pretty(&json)?)
-        .with_context(|| path.display().to_string())?;
-    Ok(())
-}
-
 impl Args {
     /// `--distance`, or the default: the volume's width across the image
     /// (and a 5 % margin) fills the sensor at the volume's centre.
     #[must_use]
     pub fn distance_or_default(&self, volume: &Volume) -> f64 {
         let b = volume.field.grid().bounds();
-        let (_, u, _) = axes(self.axis);
+        let (_, u) = self.axis.frame();
         let f = self.focal_length;
         self.distance
             .unwrap_or(f + f * 1.05 * (b.max - b.min).dot(u) / (f64::from(self.size) * self.pixel))

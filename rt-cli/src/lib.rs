@@ -12,6 +12,8 @@
 //! - `rt bos FILE`: background-oriented schlieren of your volume: the
 //!   reference and flow images of a dotted background through a thin-lens
 //!   camera and sensor, and the true displacement;
+//! - `rt focusing FILE`: focusing schlieren of your volume: a
+//!   lens-and-grid system focused on a plane in the flow;
 //! - `rt view MESH`: a ray-traced picture of a mesh (OBJ, PLY, VTK)
 //!   coloured by one of its scalars;
 //! - `rt info FILE`: what a volume or mesh holds;
@@ -29,6 +31,7 @@ pub mod bos;
 pub mod demo;
 pub mod distributed;
 mod figure;
+pub mod focusing;
 pub mod image;
 pub mod info;
 pub mod optics;
@@ -62,6 +65,9 @@ pub enum Command {
     /// Background-oriented schlieren of a volume file: the reference and
     /// flow images of a dotted background and the true displacement.
     Bos(bos::Args),
+    /// Focusing schlieren of a volume file: a lens-and-grid system focused
+    /// on a plane in the flow.
+    Focusing(focusing::Args),
     /// Ray-trace a mesh file coloured by one of its scalars.
     View(view::Args),
     /// Describe a volume or mesh file: size, geometry, value ranges.
@@ -80,6 +86,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Demo(a) => demo::run(&a),
         Command::Schlieren(a) => schlieren::run(&a),
         Command::Bos(a) => bos::run(&a),
+        Command::Focusing(a) => focusing::run(&a),
         Command::View(a) => view::run(&a),
         Command::Info(a) => info::run(&a),
         Command::Distributed(a) => distributed::run(&a),

@@ -60,7 +60,7 @@ pub enum Axis {
 
 impl Axis {
     /// The beam direction and the image's u axis.
-    fn frame(self) -> (DVec3, DVec3) {
+    pub(crate) fn frame(self) -> (DVec3, DVec3) {
         match self {
             Self::X => (DVec3::X, DVec3::Y),
             Self::Y => (DVec3::Y, DVec3::Z),

@@ -72,7 +72,7 @@ fn bump_volume(dir: &Path, negate: bool) -> PathBuf {
 fn help_lists_every_subcommand_and_every_option_with_its_default() {
     let o = rt(&["--help"]);
     assert!(o.status.success());
-    for sub in ["demo", "schlieren", "view", "info", "distributed"] {
+    for sub in ["demo", "schlieren", "bos", "focusing", "view", "info", "distributed"] {
         assert!(stdout(&o).contains(sub), "{sub}");
     }
     for sub in ["demo", "schlieren", "view", "info", "distributed"] {
@@ -590,5 +590,92 @@ fn bos_backgrounds_grid_image_and_airy() {
     for opt in ["--background", "--background-pixel", "--airy", "--wavelength"] {
         assert!(help.contains(opt), "{opt}");
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `rt focusing`: the sensor image and I/I₀ beside it; the bump shows
+/// (brighter on one side, darker on the other, as a knife edge across the
+/// bands sees it) on an undisturbed background of 1; the same seed, the
+/// same files; turning the bands turns the signal; moving the focus far
+/// from the bump blurs it away; bad input is a one-line error.
+#[test]
+fn focusing_writes_an_image_that_focuses() {
+    let dir = scratch("focusing");
+    let vol = bump_volume(&dir, false);
+    let run = |stem: &str, extra: &[&str]| {
+        let out = dir.join(format!("{stem}.png"));
+        let mut args = vec![
+            "focusing",
+            vol.to_str().unwrap(),
+            "--size",
+            "32",
+            "--samples-per-axis",
+            "4",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = rt(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(dir.join(format!("{stem}.json")).is_file());
+        let raw = std::fs::read(dir.join(format!("{stem}.raw"))).unwrap();
+        assert_eq!(raw.len(), 32 * 32 * 4);
+        let rel: Vec<f64> =
+            raw.chunks(4).map(|c| f64::from(f32::from_le_bytes(c.try_into().unwrap()))).collect();
+        (stdout(&o), rel)
+    };
+    let (said, a) = run("a", &[]);
+    assert!(said.contains("32×32") && said.contains("periods across the aperture"), "{said}");
+    // Corners: undisturbed. Left and right of the centre: the signal.
+    assert!(
+        (a[0] - 1.0).abs() < 1e-6 && (a[32 * 32 - 1] - 1.0).abs() < 1e-6,
+        "{} {}",
+        a[0],
+        a[1023]
+    );
+    let (l, r) = (a[16 * 32 + 10] - 1.0, a[16 * 32 + 21] - 1.0);
+    assert!(l.abs() > 0.05 && r.abs() > 0.05 && l * r < 0.0, "left {l}, right {r}");
+    // Above and below the centre the bands (vertical) see nothing.
+    let (u, d) = (a[10 * 32 + 16] - 1.0, a[21 * 32 + 16] - 1.0);
+    assert!(u.abs() < 0.3 * l.abs() && d.abs() < 0.3 * l.abs(), "up {u}, down {d}");
+    let (_, b) = run("b", &[]);
+    assert_eq!(a, b);
+    assert_eq!(
+        std::fs::read(dir.join("a.png")).unwrap(),
+        std::fs::read(dir.join("b.png")).unwrap()
+    );
+    // Bands turned 90°: the signal moves above and below.
+    let (_, t) = run("t", &["--angle", "90"]);
+    let (u, d) = (t[10 * 32 + 16] - 1.0, t[21 * 32 + 16] - 1.0);
+    assert!(u.abs() > 0.05 && d.abs() > 0.05 && u * d < 0.0, "turned: up {u}, down {d}");
+    // Focused 20 cm toward the lens, far from the 24 cm bump: blurred.
+    let pitch = said.split("pitch ").nth(1).unwrap().split(' ').next().unwrap().to_string();
+    let (_, far) = run("far", &["--focus", "0.2", "--pitch", &pitch]);
+    let peak = |v: &[f64]| v.iter().map(|x| (x - 1.0).abs()).fold(0.0, f64::max);
+    assert!(peak(&far) < 0.6 * peak(&a), "focused away {} vs {}", peak(&far), peak(&a));
+    // Bad input.
+    fails_with(&rt(&["focusing", dir.join("missing.nrrd").to_str().unwrap()]), &["missing.nrrd"]);
+    let o = rt(&[
+        "focusing",
+        vol.to_str().unwrap(),
+        "--duty",
+        "1.5",
+        "--out",
+        dir.join("x.png").to_str().unwrap(),
+    ]);
+    fails_with(&o, &["duty"]);
+    let o = rt(&[
+        "focusing",
+        vol.to_str().unwrap(),
+        "--source-distance",
+        "0.1",
+        "--out",
+        dir.join("x.png").to_str().unwrap(),
+    ]);
+    fails_with(&o, &["source grid"]);
+    let o = rt(&["focusing", vol.to_str().unwrap(), "--aperture", "-1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let help = rt(&["focusing", "--help"]);
+    assert!(help.status.success() && stdout(&help).contains("--source-distance"));
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -134,7 +134,7 @@ impl SourceGrid {
         // band periods; there they equal the unbounded grid's.
         let y0 = self.y(s0).max(lo).max(lo - e);
         let y1 = self.y(s1).min(hi).min(hi - e);
-        if !(y1 > y0) {
+        if y1.is_nan() || y0.is_nan() || y1 <= y0 {
             return 0.0;
         }
         let (a, b) = (0.5 * (1.0 - self.duty), 0.5 * (1.0 + self.duty));
@@ -279,12 +279,6 @@ impl FocusingSchlieren {
         (lit - self.grid.overlap_length(s0 - o, s1 - o, shift + o)).max(0.0)
     }
 
-    /// The length of `[s0, s1]` the cutoff passes: `∫ C(s) ds`.
-    fn open_length(&self, s0: f64, s1: f64) -> f64 {
-        let o = self.cutoff_offset * self.grid.pitch;
-        (s1 - s0) - self.grid.bright_length(s0 - o, s1 - o)
-    }
-
     /// The smallest deflection (radians) the set-up resolves: the one
     /// that changes a pixel's relative intensity by 1/1000 (`δ/o`, with
     /// `δ = ε·(Z_S − Z_F)` from the focus plane). Octree skipping spends
@@ -384,16 +378,17 @@ impl FocusingSchlieren {
     /// Each pixel is sampled at `k` stratified points (a jittered Latin
     /// square of `k × k` cells), and from each the aperture is cut in `k`
     /// stripes along the bands, one traced ray per stripe from a jittered
-    /// point of it. The light a ray carries depends only on where it
-    /// crosses the bands, so a stripe's is integrated exactly across it:
-    /// its lens interval maps onto an interval `[s₀⁻, s₀⁺]` of the source
-    /// plane (the undisturbed lines), which the flow moves by the traced
-    /// ray's `s₁ − s₀`; the stripe carries `∫ B(s + s₁ − s₀)·C(s) ds` over
-    /// it, in pieces (64 over the aperture) weighted by their exact areas.
-    /// Without the flow, or with a disturbance in the focus plane (every
-    /// ray of a point moved alike), this is exact whatever the bands'
-    /// pitch; elsewhere it holds while the flow's shift varies little
-    /// across a stripe. No grain from bands finer than the samples.
+    /// point of it. The light a ray carries depends on where it crosses
+    /// the bands, so it is integrated exactly across them: the aperture,
+    /// in pieces (32 over it, each weighted by its exact area), maps onto
+    /// intervals `[s₀⁻, s₀⁺]` of the source plane (the undisturbed lines
+    /// of the point), which the flow moves by a shift interpolated between
+    /// the traced rays' `s₁ − s₀`; a piece carries `∫ B(s + shift)·C(s) ds`
+    /// over its interval. Without the flow, or with a disturbance in the
+    /// focus plane (every ray of a point moved alike), this is exact
+    /// whatever the bands' pitch; elsewhere it holds while the shift is
+    /// close to linear between neighbouring rays. No grain from bands
+    /// finer than the samples.
     fn row(
         &self,
         tracer: &impl Fn(DVec3, DVec3) -> Result<TraceResult, TraceError>,
@@ -414,9 +409,10 @@ impl FocusingSchlieren {
         // at s₀ = a·R·(1 − Z_S/Z_F) + const.
         let slope = 0.5 * cam.aperture() * (1.0 - self.source_distance / cam.focus_distance);
         let width = 2.0 / kf;
-        let parts = 64u32.div_ceil(k);
+        let parts = 32u32.div_ceil(k);
         let piece = width / f64::from(parts);
         let mut out = Vec::with_capacity(cam.width);
+        let mut rays: Vec<(f64, f64)> = Vec::with_capacity(k as usize);
         for i in 0..cam.width {
             let mut rng = rng_for(seed, (j * cam.width + i) as u64);
             let (mut reference, mut flow) = (0.0, 0.0);
@@ -424,31 +420,47 @@ impl FocusingSchlieren {
                 let row = (u64::from(q) * u64::from(scramble) % u64::from(k)) as u32;
                 let px = i as f64 + (f64::from(q) + uniform_f64(&mut rng)) / kf;
                 let py = j as f64 + (f64::from(row) + uniform_f64(&mut rng)) / kf;
+                // One ray per stripe, from a jittered point of it: where
+                // it crosses the stripe (`a`, across) and how far the flow
+                // moves its source point.
+                rays.clear();
+                let mut line = 0.0;
                 for t in 0..k {
-                    let a0 = f64::from(t) * width - 1.0;
-                    let a = a0 + uniform_f64(&mut rng) * width;
+                    let a = (f64::from(t) + uniform_f64(&mut rng)) * width - 1.0;
                     let b = (2.0 * uniform_f64(&mut rng) - 1.0) * sqrt((1.0 - a * a).max(0.0));
                     let lens = (a * across.0 + b * along.0, a * across.1 + b * along.1);
                     let (o, d) = cam.ray_from(px, py, lens);
                     let s0 = self.on_source(f, o, d);
-                    // The stripe's pieces: their intervals on the source
-                    // plane and their shares of the aperture.
-                    let pieces = (0..parts).map(|m| {
-                        let (p0, p1) = (a0 + f64::from(m) * piece, a0 + f64::from(m + 1) * piece);
-                        let (e0, e1) = (s0 + (p0 - a) * slope, s0 + (p1 - a) * slope);
-                        let area = disc_area_below(p1) - disc_area_below(p0);
-                        (e0.min(e1), e0.max(e1), area / (piece * slope.abs()))
-                    });
-                    if pieces.clone().all(|(lo, hi, _)| self.open_length(lo, hi) <= 0.0) {
-                        // Blocked whatever the flow does to it: no trace.
-                        continue;
-                    }
+                    // The undisturbed lines of this point: s₀ = line + a·slope.
+                    line = s0 - a * slope;
                     let r = tracer(o, d).map_err(FocusingError::Trace)?;
-                    let shift = self.on_source(f, r.position, r.direction) - s0;
-                    for (lo, hi, weight) in pieces {
-                        reference += weight * self.transmitted(lo, hi, 0.0);
-                        flow += weight * self.transmitted(lo, hi, shift);
+                    rays.push((a, self.on_source(f, r.position, r.direction) - s0));
+                }
+                // The pieces of the aperture, each with its interval on the
+                // source plane, its area, and the shift interpolated
+                // between the rays around it (constant beyond the outer
+                // ones): a shift that changes across the aperture is
+                // followed piece by piece, not held over a stripe.
+                let mut next = 0;
+                for m in 0..k * parts {
+                    let (p0, p1) = (f64::from(m) * piece - 1.0, f64::from(m + 1) * piece - 1.0);
+                    let mid = 0.5 * (p0 + p1);
+                    while next < rays.len() && rays[next].0 < mid {
+                        next += 1;
                     }
+                    let shift = match (next.checked_sub(1).map(|i| rays[i]), rays.get(next)) {
+                        (Some((a0, d0)), Some(&(a1, d1))) => {
+                            d0 + (d1 - d0) * (mid - a0) / (a1 - a0)
+                        }
+                        (Some((_, d)), None) | (None, Some(&(_, d))) => d,
+                        (None, None) => 0.0,
+                    };
+                    let (e0, e1) = (line + p0 * slope, line + p1 * slope);
+                    let (lo, hi) = (e0.min(e1), e0.max(e1));
+                    let weight =
+                        (disc_area_below(p1) - disc_area_below(p0)) / (piece * slope.abs());
+                    reference += weight * self.transmitted(lo, hi, 0.0);
+                    flow += weight * self.transmitted(lo, hi, shift);
                 }
             }
             // Each of the k points saw the whole aperture, area π.

@@ -27,7 +27,9 @@
 //!   background-oriented schlieren as `rt bos` writes it:
 //!   `bos-reference.png`, `bos-flow.png` (a random-dot background without
 //!   and with the flow) and `bos-displacement.png` (+ `.json`/`.raw`: the
-//!   true displacement in pixels).
+//!   true displacement in pixels); and focusing schlieren as `rt
+//!   focusing` writes it: `focusing.png` (a lens-and-grid system focused
+//!   on the blast's mid-plane, + `.json`/`.raw`: I/I₀ per pixel).
 mod optics;
 
 pub use optics::{blast_wave, blast_wave_with};

@@ -8,7 +8,7 @@ use anyhow::Context;
 use rt_volume::io;
 
 use crate::{
-    bos,
+    bos, focusing,
     optics::{Interpolation, Volume},
     schlieren,
 };
@@ -58,5 +58,11 @@ pub(crate) fn render_all(out: &Path) -> anyhow::Result<()> {
     let mut a = bos::Args::from_args(Path::new("built-in"), ["--size", "384"])?;
     a.out = out.join("bos.png");
     bos::render(&volume, &a).context("bos.png")?;
+    // Focusing schlieren focused on the blast's mid-plane, exactly as
+    // `rt focusing` renders a user's file: the shock's cross-section
+    // there sharp, the shell before and behind it blurred.
+    let mut a = focusing::Args::from_args(Path::new("built-in"), ["--size", "384"])?;
+    a.out = out.join("focusing.png");
+    focusing::render(&volume, &a).context("focusing.png")?;
     Ok(())
 }

@@ -1,0 +1,270 @@
+//! `rt focusing`: focusing schlieren of a volume file: a lens-and-grid
+//! system (a grid of bright bands behind the flow, its negative as the
+//! cutoff) focused on a plane in the flow, which it shows sharply while
+//! what lies before and behind it blurs away.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use rt_photo::{
+    Cutoff, FocusingImages, FocusingSchlieren, Mode, Sensor, SourceGrid, ThinLens, TraceParams,
+};
+use rt_volume::io::read_grid;
+
+use crate::{
+    image,
+    optics::{Axis, Interpolation, Samples, Volume},
+    parse,
+};
+
+/// `rt focusing FILE`: options.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The volume: NRRD, raw + JSON sidecar or VTK image data.
+    pub file: PathBuf,
+    /// What the samples are.
+    #[command(flatten)]
+    pub samples: Samples,
+    /// Light travels along this axis, from the source grid through the
+    /// flow to the lens (the image axes are those of `rt schlieren`).
+    #[arg(long, value_enum, default_value_t = Axis::Z)]
+    pub axis: Axis,
+    /// Image width in pixels (height follows the volume's aspect).
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    pub size: u32,
+    /// Schlieren lens focal length in metres [default: the volume's
+    /// width across the image fills the sensor].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub focal_length: Option<f64>,
+    /// Schlieren lens aperture diameter in metres [default: an eighth of
+    /// the distance to the volume]: larger focuses more sharply (depth of
+    /// sharp focus ≈ 2·w·Z/D for a feature of width w at distance Z).
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub aperture: Option<f64>,
+    /// Sensor pixel pitch in metres.
+    #[arg(long, default_value_t = 5e-6, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub pixel: f64,
+    /// Distance from the lens to the volume's centre in metres [default:
+    /// twice the volume's width across the image].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub distance: Option<f64>,
+    /// The plane in focus: its distance from the volume's centre toward
+    /// the lens, metres (negative: beyond the centre).
+    #[arg(long, default_value_t = 0.0, value_parser = parse::finite, allow_hyphen_values = true)]
+    pub focus: f64,
+    /// Distance from the lens to the source grid in metres [default:
+    /// twice the focus distance].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub source_distance: Option<f64>,
+    /// Source grid pitch on its plane, metres [default: from a survey of
+    /// the flow, so that the strongest 1 % of deflections across the bands
+    /// use 80 % of the linear range; finer saturates them, then repeats].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub pitch: Option<f64>,
+    /// Bright fraction of each period of the source grid, in (0, 1).
+    #[arg(long, default_value_t = 0.5, value_parser = parse::finite, allow_hyphen_values = true)]
+    pub duty: f64,
+    /// Band orientation, degrees: 0 = bands along the image's vertical,
+    /// sensitive to horizontal deflection.
+    #[arg(long, default_value_t = 0.0, value_parser = parse::finite, allow_hyphen_values = true)]
+    pub angle: f64,
+    /// The cutoff grid's shift across the bands, in pitches: the
+    /// sensitivity (0: dark field; up to min(duty, 1 − duty)).
+    #[arg(long, default_value_t = 0.25, value_parser = parse::finite, allow_hyphen_values = true)]
+    pub offset: f64,
+    /// Number of bands, centred on the axis [default: unbounded]. Each
+    /// point of the image sees the source plane through the lens, so a
+    /// few bands light only the part of the image that sees them.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub bands: Option<u32>,
+    /// k: k² aperture samples per pixel (stripes along the bands).
+    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub samples_per_axis: u32,
+    /// Sensor: electrons at the undisturbed background.
+    #[arg(long, default_value_t = 5000.0, value_parser = parse::finite, allow_hyphen_values = true)]
+    pub exposure: f64,
+    /// Sensor full well, electrons.
+    #[arg(long, default_value_t = 10000.0, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub full_well: f64,
+    /// Sensor bit depth (8: an 8-bit PNG; more: 16-bit).
+    #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub bits: u32,
+    /// Photon shot noise (Poisson).
+    #[arg(long)]
+    pub shot_noise: bool,
+    /// Read noise, electrons rms.
+    #[arg(long, default_value_t = 0.0, value_parser = parse::finite, allow_hyphen_values = true)]
+    pub read_noise: f64,
+    /// Seed of the samples and the noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output: the image as the sensor records it (PNG; the undisturbed
+    /// background at `--exposure`), and beside it `<stem>.raw` + `.json`
+    /// (float32 I/I₀ per pixel: 1 = undisturbed, and where no band lights
+    /// the pixel even without the flow).
+    #[arg(long, default_value = "out/focusing.png")]
+    pub out: PathBuf,
+}
+
+/// Runs `rt focusing`.
+///
+/// # Errors
+/// An unreadable or unsuitable volume, a bad set-up, an unwritable output.
+pub fn run(a: &Args) -> anyhow::Result<()> {
+    let grid = read_grid(&a.file)?;
+    let volume = Volume::new(grid, a.samples.quantity, a.samples.k, false, Interpolation::Linear)
+        .with_context(|| a.file.display().to_string())?;
+    render(&volume, a).map(drop)
+}
+
+/// Renders `volume` as `a` says (its file and sample options aside),
+/// writes the image and prints one summary line.
+///
+/// # Errors
+/// A bad set-up or an unwritable output.
+pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<FocusingImages> {
+    let t = std::time::Instant::now();
+    let fs = prepare(volume, a)?;
+    let cam = fs.camera;
+    let (w, h) = (cam.width, cam.height);
+    let images = fs.render_grid(&volume.field, &volume.tree, a.seed)?;
+    let relative = images.relative();
+    // The sensor records the light, scaled so that the undisturbed
+    // background (the mean over the pixels the source lights) collects
+    // `--exposure` electrons: pixels the bands cannot reach stay dark.
+    let lit: Vec<f64> = images.reference.iter().copied().filter(|r| *r > 1e-12).collect();
+    let background = if lit.is_empty() { 1.0 } else { lit.iter().sum::<f64>() / lit.len() as f64 };
+    let light: Vec<f64> = images.flow.iter().map(|f| f / background).collect();
+    let sensor = Sensor {
+        exposure: a.exposure,
+        full_well: a.full_well,
+        bits: a.bits,
+        shot_noise: a.shot_noise,
+        read_noise: a.read_noise,
+        airy: None,
+    };
+    let counts = sensor.record(&light, w, h, a.seed)?;
+    image::write_counts(&counts, a.bits, w as u32, h as u32, &a.out)?;
+    let raw = a.out.with_extension("raw");
+    image::write_raw_f32(
+        &raw,
+        &relative,
+        1,
+        w,
+        h,
+        "focusing schlieren: I/I0 per pixel (1 = undisturbed, and where the source lights nothing), rows top first",
+    )?;
+    let mut sorted: Vec<f64> = relative.iter().map(|v| (v - 1.0).abs()).collect();
+    sorted.sort_by(f64::total_cmp);
+    let p99 = sorted[((sorted.len() - 1) as f64 * 0.99) as usize];
+    let aperture_bands = cam.aperture() * (fs.source_distance - cam.focus_distance)
+        / cam.focus_distance
+        / fs.grid.pitch;
+    println!(
+        "wrote {}, {} ({w}×{h}, {} rays in {:.2} s; f = {:.4} m, aperture {:.3} m, focus {:.3} m from the lens, source grid at {:.3} m, pitch {:.3e} m ({aperture_bands:.1} periods across the aperture's view), cutoff offset {} pitch; |I/I₀ − 1| 99th percentile {p99:.3})",
+        a.out.display(),
+        raw.with_extension("json").display(),
+        w * h * (a.samples_per_axis * a.samples_per_axis) as usize,
+        t.elapsed().as_secs_f64(),
+        cam.focal_length,
+        cam.aperture(),
+        cam.focus_distance,
+        fs.source_distance,
+        fs.grid.pitch,
+        fs.cutoff_offset,
+    );
+    Ok(images)
+}
+
+/// The set-up `a` describes for `volume` (`rt focusing`, the demo and
+/// rtvis go through here): the camera on the +axis side of the volume's
+/// centre looking back along −axis (light travels +axis, so the image's
+/// x runs along u as in `rt schlieren`), focused `--focus` toward the lens
+/// from the centre; the source grid behind the volume, its pitch from a
+/// survey of the flow unless given; two-cell leapfrog steps.
+///
+/// # Errors
+/// The focus plane closer to the lens than its focal length, the source
+/// grid not beyond it, or a bad set-up.
+pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<FocusingSchlieren> {
+    let b = volume.field.grid().bounds();
+    let (axis, u) = a.axis.frame();
+    let v = axis.cross(u);
+    let ext = b.max - b.min;
+    let w = a.size as usize;
+    let h = ((f64::from(a.size) * ext.dot(v) / ext.dot(u)).round() as usize).max(1);
+    let width = ext.dot(u);
+    let z = a.distance.unwrap_or(2.0 * width);
+    let z_f = z - a.focus;
+    // The magnification that fits the volume's width (and 5 %) on the
+    // sensor at its centre, M = f/(Z − f).
+    let m = f64::from(a.size) * a.pixel / (1.05 * width);
+    let f = a.focal_length.unwrap_or(m * z / (1.0 + m));
+    if z_f <= f {
+        bail!(
+            "the focus plane must be farther from the lens ({z_f} m) than its focal length ({f} m)"
+        );
+    }
+    let z_s = a.source_distance.unwrap_or(2.0 * z_f);
+    if z_s.is_nan() || z_s <= z_f {
+        bail!("the source grid ({z_s} m from the lens) must lie beyond the focus plane ({z_f} m)");
+    }
+    let aperture = a.aperture.unwrap_or(z / 8.0);
+    let camera = ThinLens {
+        position: 0.5 * (b.min + b.max) + z * axis,
+        direction: -axis,
+        up: v,
+        focal_length: f,
+        f_number: f / aperture,
+        focus_distance: z_f,
+        pixel_pitch: a.pixel,
+        width: w,
+        height: h,
+    };
+    let angle = a.angle.to_radians();
+    let lever = z_s - z_f;
+    let pitch = match a.pitch {
+        Some(p) => p,
+        None => {
+            // |I/I₀ − 1| = ε·(Z_S − Z_F)/(offset·pitch) while the source
+            // points move less than the cutoff's offset; beyond, the image
+            // saturates and then repeats band by band. 0.8 for the 99th
+            // percentile of the deflection across the bands. A flow without
+            // deflections: 20 bands across the aperture's view of the
+            // source plane, D·(Z_S − Z_F)/Z_F.
+            let survey =
+                volume.survey(&volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0))?;
+            let eps = survey.along(angle, 0.99);
+            if eps > 0.0 && a.offset > 0.0 {
+                eps * lever / (0.8 * a.offset)
+            } else {
+                aperture * lever / z_f / 20.0
+            }
+        }
+    };
+    let base = TraceParams::for_grid(&volume.field);
+    let fs = FocusingSchlieren {
+        camera,
+        source_distance: z_s,
+        grid: SourceGrid { pitch, duty: a.duty, angle, bands: a.bands },
+        cutoff_offset: a.offset,
+        aperture_samples: a.samples_per_axis,
+        params: TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base },
+    };
+    fs.validate()?;
+    Ok(fs)
+}
+
+impl Args {
+    /// The options `rt focusing FILE ARGS…` would parse to.
+    ///
+    /// # Errors
+    /// What clap reports for bad arguments.
+    pub fn from_args<I, T>(file: &Path, args: I) -> Result<Self, clap::Error>
+    where
+        I: IntoIterator<Item = T>,
+        T: Into<std::ffi::OsString> + Clone,
+    {
+        crate::parse::subcommand("focusing", file, args)
+    }
+}
