@@ -127,7 +127,7 @@ pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
     let (w, h) = (camera.width, camera.height);
     let (f, z_a) = (camera.focal_length, a.distance_or_default(volume));
     let z_d = camera.focus_distance - z_a;
-    let images = bos.render(&volume.field, a.seed)?;
+    let images = bos.render_grid(&volume.field, &volume.tree, a.seed)?;
     let sensor = Sensor {
         exposure: a.exposure,
         full_well: a.full_well,

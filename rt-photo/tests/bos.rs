@@ -327,3 +327,50 @@ fn bad_background_images_are_errors() {
     let e = ImageBackground::new(2, 2, vec![0.5; 3], 1.0).unwrap_err();
     assert!(e.to_string().contains("2×2") && e.to_string().contains('3'), "{e}");
 }
+
+/// rt's default for grids: octree skipping within a per-ray budget of a
+/// tenth of a pixel of displacement ([`Bos::resolvable_deflection`])
+/// gives the ground truth of plain tracing to 0.1 px, and the same images
+/// at any thread count.
+#[test]
+fn grid_render_with_octree_matches_plain_tracing() {
+    use rt_volume::{Grid, GridField, Interp, build_octree};
+    let (n, h, z_a) = (64, 1e-3, 1.1);
+    let half = 0.5 * h * (n - 1) as f64;
+    let origin = DVec3::new(-half, -half, z_a - half);
+    let mut data = Vec::with_capacity(n * n * n);
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                let p = origin + DVec3::new(i as f64, j as f64, k as f64) * h
+                    - DVec3::new(0.0, 0.0, z_a);
+                data.push((1.0 + 1e-3 * (-p.length_squared() / (2.0 * 1e-4)).exp()) as f32);
+            }
+        }
+    }
+    let g = Grid::new([n; 3], origin, DVec3::splat(h), data).unwrap();
+    let field = GridField::new(g, Interp::CatmullRom, 1.0).unwrap();
+    let tree = build_octree(&field).unwrap();
+    // 50 µm pixels: the 48 × 40 image spans ±12 mm of the bump (σ = 1 cm,
+    // δ = 1e-3: 1.5 px at the peak).
+    let cam = ThinLens { pixel_pitch: 5e-5, ..camera(16.0, 48, 40) };
+    let b = Bos { params: TraceParams::for_grid(&field), ..bos(cam, 2) };
+    // 0.1 px of 50 µm at M = 0.05 over Z_D = 1 m: 1e-4 rad.
+    assert!((b.resolvable_deflection(z_a) - 1e-4).abs() < 1e-15);
+    let plain = b.render(&field, 3).unwrap();
+    let render = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| b.render_grid(&field, &tree, 3).unwrap())
+    };
+    let fast = render(1);
+    assert_eq!(fast, render(3));
+    let worst = plain
+        .displacement
+        .iter()
+        .zip(&fast.displacement)
+        .map(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1]))
+        .fold(0.0f64, f64::max);
+    assert!(worst <= 0.1, "octree vs plain: {worst} px");
+    let peak = plain.displacement.iter().map(|d| d[0].hypot(d[1])).fold(0.0f64, f64::max);
+    assert!(peak > 1.2, "the bump moves the background: {peak} px");
+}
