@@ -29,6 +29,7 @@ fn _rtvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(optics::optics, m)?)?;
     m.add_function(wrap_pyfunction!(optics::record, m)?)?;
     m.add_function(wrap_pyfunction!(optics::bos, m)?)?;
+    m.add_function(wrap_pyfunction!(optics::focusing, m)?)?;
     m.add_class::<surface::PyScene>()?;
     m.add_function(wrap_pyfunction!(composite::composite, m)?)?;
     m.add_function(wrap_pyfunction!(composite::composite_comm, m)?)?;

@@ -1,7 +1,9 @@
 //! The optical bench: schlieren (every cutoff), shadowgraph,
 //! interferometry and colour schlieren of a volume, set up as `rt
 //! schlieren` sets it up (the same defaults, the same automatic exposure,
-//! the same photons), so both give the same image for the same options.
+//! the same photons), so both give the same image for the same options;
+//! background-oriented and focusing schlieren set up by `rt bos`'s and `rt
+//! focusing`'s own option parsers, for the same reason.
 
 use std::path::PathBuf;
 
@@ -32,6 +34,12 @@ fn parse<E: ValueEnum>(what: &str, s: &str) -> PyResult<E> {
             .collect();
         value_error(format!("{what}: unknown `{s}` (known: {})", known.join(", ")))
     })
+}
+
+/// A `ValueError` carrying the first line of what clap says about bad
+/// command-line arguments.
+fn command_line_error(e: clap::Error) -> PyErr {
+    value_error(e.to_string().lines().next().unwrap_or_default().trim_start_matches("error: "))
 }
 
 /// `Err` unless `v` is finite and `> 0`.
@@ -199,9 +207,8 @@ pub(crate) fn bos<'py>(
     image: Option<PyReadonlyArray2<'py, f64>>,
     image_pixel: Option<f64>,
 ) -> PyResult<BosOut<'py>> {
-    let a = rt_cli::bos::Args::from_args(std::path::Path::new("volume"), args).map_err(|e| {
-        value_error(e.to_string().lines().next().unwrap_or_default().trim_start_matches("error: "))
-    })?;
+    let a = rt_cli::bos::Args::from_args(std::path::Path::new("volume"), args)
+        .map_err(command_line_error)?;
     let v = &volume.inner;
     let image = image.map(|i| {
         let view = i.as_array();
@@ -239,6 +246,63 @@ pub(crate) fn bos<'py>(
         Array2::from_shape_vec((h, w), images.reference).map_err(value_error)?.into_pyarray(py),
         Array2::from_shape_vec((h, w), images.flow).map_err(value_error)?.into_pyarray(py),
         Array3::from_shape_vec((h, w, 2), disp).map_err(value_error)?.into_pyarray(py),
+        said,
+    ))
+}
+
+/// `(reference [h, w], flow [h, w], I/I₀ [h, w], a line describing the
+/// set-up)`.
+type FocusingOut<'py> =
+    (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, String);
+
+/// Focusing schlieren of `volume`, set up by `rt focusing`'s own options
+/// (`args`: its command-line arguments after the file), so every default
+/// and every automatic choice (the grid's pitch from a survey of the flow)
+/// is the command line's.
+#[pyfunction]
+#[pyo3(name = "_focusing")]
+#[pyo3(signature = (volume, args))]
+pub(crate) fn focusing<'py>(
+    py: Python<'py>,
+    volume: &PyVolume,
+    args: Vec<String>,
+) -> PyResult<FocusingOut<'py>> {
+    let a = rt_cli::focusing::Args::from_args(std::path::Path::new("volume"), args)
+        .map_err(command_line_error)?;
+    let v = &volume.inner;
+    let (fs, images) = py
+        .detach(|| -> anyhow::Result<_> {
+            let fs = rt_cli::focusing::prepare(v, &a)?;
+            let images = fs.render_grid(&v.field, &v.tree, a.seed)?;
+            Ok((fs, images))
+        })
+        .map_err(value_error)?;
+    let (w, h) = (images.width, images.height);
+    let c = fs.camera;
+    let z_f = c.focus_distance;
+    // Shortest round-trip decimals: the pitch said here, passed back as
+    // `pitch`, gives the same image.
+    let said = format!(
+        "f = {:e} m, aperture {:e} m (f/{:.4}), focus {:e} m from the lens, source grid at {:e} m, pitch {:e} m ({:.1} periods across the aperture's view), duty {}, angle {}°, cutoff offset {} pitch, {}×{} pixels of {:e} m",
+        c.focal_length,
+        c.aperture(),
+        c.f_number,
+        z_f,
+        fs.source_distance,
+        fs.grid.pitch,
+        c.aperture() * (fs.source_distance - z_f) / z_f / fs.grid.pitch,
+        fs.grid.duty,
+        a.angle,
+        fs.cutoff_offset,
+        w,
+        h,
+        c.pixel_pitch
+    );
+    let relative = images.relative();
+    Ok((
+        Array2::from_shape_vec((h, w), images.reference).map_err(value_error)?.into_pyarray(py),
+        Array2::from_shape_vec((h, w), images.flow).map_err(value_error)?.into_pyarray(py),
+        Array2::from_shape_vec((h, w), relative).map_err(value_error)?.into_pyarray(py),
         said,
     ))
 }
