@@ -27,6 +27,11 @@ pub struct Args {
     /// What the samples are.
     #[command(flatten)]
     pub samples: Samples,
+    /// Interpolation between samples (`cubic`: Catmull–Rom, a smooth
+    /// gradient; `rt-report bos`: 0.004 px from the paraxial relation on a
+    /// bump of 10 cells' σ, where `linear` is 0.09 px off).
+    #[arg(long, value_enum, default_value_t = Interpolation::Linear)]
+    pub interp: Interpolation,
     /// Light travels along this axis, from the background through the flow
     /// to the camera (the image axes are those of `rt schlieren`).
     #[arg(long, value_enum, default_value_t = Axis::Z)]
@@ -110,7 +115,7 @@ pub struct Args {
 /// An unreadable or unsuitable volume, a bad set-up, an unwritable output.
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let grid = read_grid(&a.file)?;
-    let volume = Volume::new(grid, a.samples.quantity, a.samples.k, false, Interpolation::Linear)
+    let volume = Volume::new(grid, a.samples.quantity, a.samples.k, false, a.interp)
         .with_context(|| a.file.display().to_string())?;
     render(&volume, a)
 }

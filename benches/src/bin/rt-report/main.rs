@@ -7,6 +7,8 @@
 //! cargo run --release -p rt-benches --bin rt-report -- octree [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- schlieren [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- noise [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- bos [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- focusing [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- render [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- composite [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- gl [--quick]         # needs xvfb-run, cc, glxgears
@@ -15,9 +17,11 @@
 // A std-only tool crate: the no_std import lints guard the libraries.
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
+mod bos;
 mod composite;
 #[cfg(feature = "embree3")]
 mod embree3;
+mod focusing;
 mod gl;
 mod grin;
 mod noise;
@@ -101,7 +105,8 @@ fn index(sections: &[(&str, Section)], quick: bool, seconds: f64) -> String {
 const USAGE: &str = "usage: rt-report [AREA ...] [--quick]
 
 Writes tables, CSV files and plots under target/rt-report/.
-AREA: traversal, grin, octree, schlieren, noise, render, composite (none or
+AREA: traversal, grin, octree, schlieren, noise, bos, focusing, render,
+composite (none or
 `all`: every one of these, plus target/rt-report/index.md), or gl (rt-gl
 against Mesa; needs xvfb-run, cc and glxgears; not part of `all`).
 --quick: smaller problems, fewer repetitions (checks the pipeline, not the
@@ -123,7 +128,17 @@ fn main() -> ExitCode {
         args.iter().filter(|a| !a.starts_with("--")).map(String::as_str).collect();
     let all = areas.is_empty() || areas == ["all"];
     let areas = if all {
-        vec!["traversal", "grin", "octree", "schlieren", "noise", "render", "composite"]
+        vec![
+            "traversal",
+            "grin",
+            "octree",
+            "schlieren",
+            "noise",
+            "bos",
+            "focusing",
+            "render",
+            "composite",
+        ]
     } else {
         areas
     };
@@ -140,11 +155,13 @@ fn main() -> ExitCode {
             "octree" => octree::run(&dir, quick),
             "schlieren" => schlieren::run(&dir, quick),
             "noise" => noise::run(&dir, quick),
+            "bos" => bos::run(&dir, quick),
+            "focusing" => focusing::run(&dir, quick),
             "render" => render::run(&dir, quick),
             "composite" => composite::run(&dir, quick),
             "gl" => gl::run(&dir, quick),
             other => Err(format!(
-                "unknown area `{other}` (known: traversal, grin, octree, schlieren, noise, render, composite, gl, all)"
+                "unknown area `{other}` (known: traversal, grin, octree, schlieren, noise, bos, focusing, render, composite, gl, all)"
             )),
         };
         match result {
