@@ -223,7 +223,7 @@ pub(crate) fn bos<'py>(
                 bos.background =
                     ImageBackground::for_camera(&bos.camera, w, h, samples, px)?.into();
             }
-            let images = bos.render(&v.field, a.seed)?;
+            let images = bos.render_grid(&v.field, &v.tree, a.seed)?;
             Ok((bos, images))
         })
         .map_err(value_error)?;
