@@ -21,6 +21,8 @@
 //! [`Bos`] renders background-oriented schlieren through a [`ThinLens`]
 //! camera: the reference and flow images of a [`Background`] (random
 //! dots, a dot grid or an image) and the ground-truth displacement.
+//! [`FocusingSchlieren`] renders a lens-and-grid system focused on a
+//! plane in the flow, which it shows sharply while the rest blurs away.
 //!
 //! The `rt-volume` types this crate's API takes are re-exported at the
 //! root ([`IndexField`], [`GridField`], [`Octree`], [`TraceParams`], …),
