@@ -346,14 +346,7 @@ impl Bos {
     ) -> Result<BosImages, BosError> {
         self.validate()?;
         let (w, h) = (self.camera.width, self.camera.height);
-        let row = |j: usize| self.row(tracer, j, seed);
-        #[cfg(feature = "parallel")]
-        let rows: Vec<Result<Vec<Pixel>, BosError>> = {
-            use rayon::prelude::*;
-            (0..h).into_par_iter().map(row).collect()
-        };
-        #[cfg(not(feature = "parallel"))]
-        let rows: Vec<Result<Vec<Pixel>, BosError>> = (0..h).map(row).collect();
+        let rows = rows(h, |j| self.row(tracer, j, seed));
         let mut out = BosImages {
             width: w,
             height: h,
@@ -421,6 +414,24 @@ impl Bos {
             out.push(px);
         }
         Ok(out)
+    }
+}
+
+/// `row(j)` for rows `0..h`, in order: in parallel with feature
+/// `parallel` (each row its own work, so the result does not depend on the
+/// thread count).
+pub(crate) fn rows<P: Send, E: Send>(
+    h: usize,
+    row: impl Fn(usize) -> Result<Vec<P>, E> + Sync + Send,
+) -> Vec<Result<Vec<P>, E>> {
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        (0..h).into_par_iter().map(row).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        (0..h).map(row).collect()
     }
 }
 

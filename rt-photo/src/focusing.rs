@@ -341,14 +341,7 @@ impl FocusingSchlieren {
         self.validate()?;
         let (w, h) = (self.camera.width, self.camera.height);
         let frame = self.camera.frame();
-        let row = |j: usize| self.row(tracer, &frame, j, seed);
-        #[cfg(feature = "parallel")]
-        let rows: Vec<Result<Vec<[f64; 2]>, FocusingError>> = {
-            use rayon::prelude::*;
-            (0..h).into_par_iter().map(row).collect()
-        };
-        #[cfg(not(feature = "parallel"))]
-        let rows: Vec<Result<Vec<[f64; 2]>, FocusingError>> = (0..h).map(row).collect();
+        let rows = crate::bos::rows(h, |j| self.row(tracer, &frame, j, seed));
         let mut out = FocusingImages {
             width: w,
             height: h,
