@@ -129,7 +129,8 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let mut md = String::from(
         "| Δz (m, + away from the lens) | signal max\\|I/I₀ − 1\\| | ÷ lever | geometric prediction ÷ lever | seconds |\n|---|---|---|---|---|\n",
     );
-    let (mut near, mut far, mut pred) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut near, mut far, mut pred, mut pred_far) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut in_focus = 0.0;
     for &step in &steps {
         for side in [-1.0, 1.0] {
@@ -162,6 +163,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             }
             if side > 0.0 || step == 0.0 {
                 far.push((x, signal * lever));
+                pred_far.push((x, p * lever));
             }
         }
     }
@@ -191,7 +193,8 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         series: vec![
             Series { name: "bump toward the lens".into(), points: near },
             Series { name: "bump away from the lens".into(), points: far },
-            Series { name: "geometric prediction".into(), points: pred },
+            Series { name: "geometric prediction, toward".into(), points: pred.clone() },
+            Series { name: "geometric prediction, away".into(), points: pred_far },
         ],
     };
     loglog(&plot, 900, 600, &dir.join("focusing.png")).map_err(|e| e.to_string())?;
