@@ -405,6 +405,14 @@ impl FocusingSchlieren {
         let parts = 32u32.div_ceil(k);
         let piece = width / f64::from(parts);
         let mut out = Vec::with_capacity(cam.width);
+        // Each piece's share of the aperture, per unit of its interval on
+        // the source plane: the same for every pixel.
+        let weights: Vec<f64> = (0..k * parts)
+            .map(|m| {
+                let (p0, p1) = (f64::from(m) * piece - 1.0, f64::from(m + 1) * piece - 1.0);
+                (disc_area_below(p1) - disc_area_below(p0)) / (piece * slope.abs())
+            })
+            .collect();
         let mut rays: Vec<(f64, f64)> = Vec::with_capacity(k as usize);
         for i in 0..cam.width {
             let mut rng = rng_for(seed, (j * cam.width + i) as u64);
@@ -450,8 +458,7 @@ impl FocusingSchlieren {
                     };
                     let (e0, e1) = (line + p0 * slope, line + p1 * slope);
                     let (lo, hi) = (e0.min(e1), e0.max(e1));
-                    let weight =
-                        (disc_area_below(p1) - disc_area_below(p0)) / (piece * slope.abs());
+                    let weight = weights[m as usize];
                     reference += weight * self.transmitted(lo, hi, 0.0);
                     flow += weight * self.transmitted(lo, hi, shift);
                 }
