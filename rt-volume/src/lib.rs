@@ -57,6 +57,8 @@ mod grid;
 pub mod io;
 mod mapping;
 mod math;
+#[cfg(feature = "mesh")]
+pub mod mesh;
 #[cfg(feature = "alloc")]
 pub mod skip;
 mod trace;
@@ -68,6 +70,8 @@ pub use field::{Bounds, IndexField};
 #[cfg(feature = "alloc")]
 pub use grid::{Grid, GridError, GridField, Interp};
 pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
+#[cfg(feature = "mesh")]
+pub use mesh::{Cell, MeshError, UnstructuredField};
 #[cfg(feature = "alloc")]
 pub use skip::{
     BRICK, BeamMask, BeamWindow, MAX_BEAM_CELLS, OctNode, Octree, OctreeError, SmoothNode,
