@@ -489,7 +489,7 @@ impl Bench {
         self.render_colored_with(&tracer, film, pass, seed)
     }
 
-    fn render_colored_with(
+    pub(crate) fn render_colored_with(
         &self,
         tracer: &(impl Fn(DVec3, DVec3) -> Result<(TraceResult, [f32; 3]), TraceError> + Sync),
         film: &mut Film,

@@ -35,6 +35,7 @@
 //! | `std` | yes | float functions from std (here, in `rt-volume` and `rt-core`) |
 //! | `libm` | no | float functions from `libm` for `no_std` builds |
 //! | `parallel` | no | rows traced and films splatted with rayon (implies `std`); images stay bit-identical |
+//! | `mesh` | no | unstructured meshes (`rt_volume::UnstructuredField`) on every optical system: `Bench::render_mesh`, `Bos::render_mesh`, `FocusingSchlieren::render_mesh` (implies `std`) |
 //!
 //! Without `std`, one of `std` or `libm` must be on; an allocator is always
 //! needed (films and photon rows live on `alloc`).
@@ -89,6 +90,8 @@ mod cutoff;
 mod film;
 mod focusing;
 mod math;
+#[cfg(feature = "mesh")]
+mod mesh;
 mod sensor;
 mod sheet;
 
@@ -103,6 +106,8 @@ pub use sensor::{Sensor, SensorError};
 // The types in this crate's signatures, from the crates below it (and
 // `build_octree`, the only way to the `Octree` that `render_grid` takes).
 pub use rt_core::ColorMap;
+#[cfg(feature = "mesh")]
+pub use rt_volume::{Cell, MeshError, UnstructuredField};
 pub use rt_volume::{
     GridField, IndexField, Octree, TraceError, TraceParams, TraceResult, build_octree,
 };
