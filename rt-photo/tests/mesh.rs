@@ -7,7 +7,7 @@ mod support;
 
 use rt_photo::glam::DVec3;
 use rt_photo::rt_volume::{Grid, GridField, IndexField, Interp};
-use rt_photo::{Cell, Film, Filter, Mode, UnstructuredField};
+use rt_photo::{Cell, Film, Filter, UnstructuredField};
 use support::{bench, knife};
 
 /// The hexahedral mesh of `n` points a side over `[lo, hi]³`, `f` at the
