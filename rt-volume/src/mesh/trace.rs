@@ -322,7 +322,13 @@ impl UnstructuredField {
                 let arc = Arc { x0: cur, t0: tt, n0: n, grad, g: grad.length(), k: grad.dot(tt) };
                 let step = self.leave(tet, &arc);
                 let (x1, t1, dopl) = arc.at(step.t);
-                if !(x1.is_finite() && t1.is_finite() && dopl.is_finite()) || t1 == DVec3::ZERO {
+                if !(x1.is_finite() && t1.is_finite() && dopl.is_finite())
+                    || t1 == DVec3::ZERO
+                    || !self.near_cell(tet, x1)
+                {
+                    // Overflow, or an index so steep across the cell (n
+                    // from ~0 to huge) that the exit could not be resolved
+                    // in f64: the exit point is not on the cell.
                     return Err(TraceError::BadField { at: cur });
                 }
                 opl += dopl;
@@ -399,6 +405,17 @@ impl UnstructuredField {
             best = Step { t: 0.0, face: i };
         }
         best
+    }
+
+    /// Whether `x` is within the box of `tet`'s points, grown by a millionth
+    /// of its size (the exit point of a step lies on one of its faces, to
+    /// round-off).
+    fn near_cell(&self, tet: usize, x: DVec3) -> bool {
+        let p = self.tets[tet].map(|i| self.points[i as usize]);
+        let lo = p[0].min(p[1]).min(p[2]).min(p[3]);
+        let hi = p[0].max(p[1]).max(p[2]).max(p[3]);
+        let slack = 1e-6 * (hi - lo).max_element() + 1e-12 * lo.abs().max(hi.abs()).max_element();
+        (lo - slack).cmple(x).all() && x.cmple(hi + slack).all()
     }
 
     /// The outward normal of boundary face `4·tet + i`.
