@@ -102,7 +102,8 @@ impl fmt::Display for ReadErrorKind {
         match self {
             Self::Io(e) => write!(f, "{e}"),
             Self::UnknownFormat => f.write_str(
-                "unknown grid format (expected .nrrd, .nhdr, .json with .raw, .vtk or .vti)",
+                "unknown grid format (expected .nrrd, .nhdr, .json with .raw, .vtk or .vti; \
+                 unstructured grids .vtk or .vtu)",
             ),
             Self::Malformed { message, source: Some(e) } => {
                 // One line: parsers' messages may go on with dumps of their

@@ -1,14 +1,21 @@
-//! Readers for gridded data (feature `io`): raw samples with a JSON header
-//! (the project's sidecar format), NRRD (the original tool's format) and
-//! VTK image data (through `vtkio`).
+//! File readers (feature `io`). Gridded data ([`read_grid`]): raw samples
+//! with a JSON header (the project's sidecar format), NRRD (the original
+//! tool's format) and VTK image data (through `vtkio`). Unstructured grids
+//! ([`read_unstructured`], told apart by [`is_unstructured`]): VTK legacy
+//! `UNSTRUCTURED_GRID` and XML `.vtu`, as points, linear volume cells
+//! ([`Cell`](crate::Cell)) and one scalar per point.
 //! Every malformed, truncated or oversized input is an `Err` naming the
 //! problem; samples that are NaN or infinite are rejected.
 
+mod base64;
 mod decode;
 mod error;
+mod legacy_scan;
 mod nrrd;
 mod raw_json;
+mod unstructured;
 mod vtk;
+mod xml_scan;
 
 use alloc::vec::Vec;
 use std::{fs, path::Path};
@@ -16,6 +23,7 @@ use std::{fs, path::Path};
 pub use error::{ReadError, ReadErrorKind};
 pub use nrrd::{parse_nrrd, read_nrrd};
 pub use raw_json::{parse_raw_json, read_raw_json};
+pub use unstructured::{UnstructuredData, is_unstructured, read_unstructured};
 pub use vtk::read_vtk;
 
 use crate::Grid;
@@ -27,7 +35,9 @@ fn read(path: &Path) -> Result<Vec<u8>, ReadError> {
 
 /// Reads a grid by extension: `.nrrd`/`.nhdr` as NRRD, `.json` as a raw
 /// header (a `.raw` file is read through the `.json` beside it),
-/// `.vtk`/`.vti` as VTK image data.
+/// `.vtk`/`.vti` as VTK image data. Unstructured grids (`.vtu`, and
+/// `.vtk` files [`is_unstructured`] picks out) are read with
+/// [`read_unstructured`].
 ///
 /// # Errors
 /// [`ReadError`] naming the problem and the file; an unknown extension is

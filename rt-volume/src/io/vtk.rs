@@ -9,6 +9,8 @@ use glam::DVec3;
 use super::{
     ReadError, ReadErrorKind,
     error::{malformed, parse_error, unsupported},
+    legacy_scan::check_legacy_sizes,
+    xml_scan::prepare_xml,
 };
 use crate::Grid;
 
@@ -26,11 +28,23 @@ pub fn read_vtk(path: &Path) -> Result<Grid, ReadError> {
 
 fn vtk_grid(path: &Path) -> Result<Grid, ReadError> {
     use vtkio::model::{Attribute, DataSet, Extent};
-    let vtk = vtkio::Vtk::import(path).map_err(|e| match e {
+    let to_read_error = |e| match e {
         vtkio::Error::IO(io) => ReadError::from(ReadErrorKind::Io(io)),
         other => parse_error("VTK", other),
-    })?;
+    };
+    let vtk = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("vtk")) {
+        // Checked first: `vtkio` reserves memory for the counts declared.
+        let bytes = super::read(path)?;
+        check_legacy_sizes(&bytes)?;
+        vtkio::Vtk::parse_legacy_be(bytes.as_slice()).map_err(to_read_error)?
+    } else {
+        let bytes = prepare_xml(super::read(path)?)?;
+        vtkio::Vtk::parse_xml(bytes.as_slice()).map_err(to_read_error)?
+    };
     let DataSet::ImageData { extent, origin, spacing, pieces, .. } = vtk.data else {
+        if matches!(vtk.data, DataSet::UnstructuredGrid { .. }) {
+            return Err(unsupported("VTK unstructured grid: read it with `read_unstructured`"));
+        }
         return Err(unsupported("VTK data set other than image data / structured points"));
     };
     let dims = match extent {
