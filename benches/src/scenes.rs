@@ -3,7 +3,7 @@
 use glam::Vec3;
 use rt_core::{Camera, Projection, Ray, glam::Vec2, sampling};
 use rt_photo::{Bench, Cutoff, Mode, Reconstruction, Weighting};
-use rt_volume::{Grid, GridField, Interp, TraceParams, glam::DVec3};
+use rt_volume::{Cell, Grid, GridField, Interp, TraceParams, glam::DVec3};
 
 /// An indexed triangle mesh.
 #[derive(Clone, Debug, Default)]
@@ -148,4 +148,67 @@ pub fn knife_bench(params: TraceParams, strata: u32) -> Bench {
         strata,
         params,
     }
+}
+
+/// The box `[lo, hi]` cut into `n³` hexahedra (VTK order) on a regular
+/// lattice of `(n + 1)³` points, the point numbering shuffled with `seed`
+/// (Fisher–Yates, SplitMix64). Hexahedra are split into tetrahedra along
+/// the diagonals through their lowest-numbered points, so the shuffle
+/// makes the diagonals vary from cell to cell as in a real mesh's file.
+///
+/// # Panics
+/// If `n` is zero or the points overflow `u32`.
+#[must_use]
+pub fn box_hex_mesh(lo: DVec3, hi: DVec3, n: usize, seed: u64) -> (Vec<DVec3>, Vec<Cell>) {
+    assert!(n > 0, "a box mesh needs at least one cell per side");
+    let side = n + 1;
+    let count = side.pow(3);
+    assert!(u32::try_from(count).is_ok(), "{count} points overflow u32");
+    let h = (hi - lo) / n as f64;
+    let lattice = |i: usize, j: usize, k: usize| i + side * (j + side * k);
+    // SplitMix64 (Steele, Lea & Flood 2014): small, seeded, good enough
+    // for a permutation.
+    let mut state = seed;
+    let mut next = move || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    };
+    // `perm[lattice index]` = the point's number in the file.
+    let mut perm: Vec<u32> = (0..count as u32).collect();
+    for i in (1..count).rev() {
+        perm.swap(i, (next() % (i as u64 + 1)) as usize);
+    }
+    let mut points = vec![DVec3::ZERO; count];
+    for k in 0..side {
+        for j in 0..side {
+            for i in 0..side {
+                points[perm[lattice(i, j, k)] as usize] =
+                    lo + h * DVec3::new(i as f64, j as f64, k as f64);
+            }
+        }
+    }
+    let mut cells = Vec::with_capacity(n.pow(3));
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                cells.push(Cell::Hexahedron(
+                    [
+                        (i, j, k),
+                        (i + 1, j, k),
+                        (i + 1, j + 1, k),
+                        (i, j + 1, k),
+                        (i, j, k + 1),
+                        (i + 1, j, k + 1),
+                        (i + 1, j + 1, k + 1),
+                        (i, j + 1, k + 1),
+                    ]
+                    .map(|(a, b, c)| perm[lattice(a, b, c)]),
+                ));
+            }
+        }
+    }
+    (points, cells)
 }

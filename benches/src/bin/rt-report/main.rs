@@ -11,6 +11,7 @@
 //! cargo run --release -p rt-benches --bin rt-report -- focusing [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- render [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- composite [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- unstructured [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- gl [--quick]         # needs xvfb-run, cc, glxgears
 //! cargo run --release -p rt-benches --bin rt-report -- all [--quick]   # + index.md
 //! ```
@@ -32,6 +33,7 @@ mod timing;
 #[cfg(feature = "tinybvh")]
 mod tinybvh;
 mod traversal;
+mod unstructured;
 
 use std::{path::PathBuf, process::ExitCode};
 
@@ -106,11 +108,23 @@ const USAGE: &str = "usage: rt-report [AREA ...] [--quick]
 
 Writes tables, CSV files and plots under target/rt-report/.
 AREA: traversal, grin, octree, schlieren, noise, bos, focusing, render,
-composite (none or
+composite, unstructured (none or
 `all`: every one of these, plus target/rt-report/index.md), or gl (rt-gl
 against Mesa; needs xvfb-run, cc and glxgears; not part of `all`).
 --quick: smaller problems, fewer repetitions (checks the pipeline, not the
-targets).";
+targets).
+
+unstructured writes unstructured.csv (case,method,cells,seconds,
+max_deflection_error: the Gaussian bump on N = 8..64 cells per side, 64x64
+rays, one thread, error = |exit direction - exact| / peak deflection),
+unstructured_detail.csv (case,method,cells,build_seconds,seconds,rays,
+rays_per_s,max_deflection_error,mean_deflection_error,max_pixel_error,
+stalled: + mean over the rays, the largest error of 8x8-ray pixel means
+and the rays that did not leave the far side) and
+unstructured_throughput.csv (method,case,cells,build_seconds,rays,threads,
+seconds,photons_per_s,cells_crossed,cells_per_s: a 256x256 beam through
+the N = 64 mesh, 1.57M tetrahedra, one thread and all cores;
+cells_crossed = sum of TraceStats::steps, the tetrahedra crossed).";
 
 fn main() -> ExitCode {
     let t0 = std::time::Instant::now();
@@ -138,6 +152,7 @@ fn main() -> ExitCode {
             "focusing",
             "render",
             "composite",
+            "unstructured",
         ]
     } else {
         areas
@@ -159,9 +174,10 @@ fn main() -> ExitCode {
             "focusing" => focusing::run(&dir, quick),
             "render" => render::run(&dir, quick),
             "composite" => composite::run(&dir, quick),
+            "unstructured" => unstructured::run(&dir, quick),
             "gl" => gl::run(&dir, quick),
             other => Err(format!(
-                "unknown area `{other}` (known: traversal, grin, octree, schlieren, noise, bos, focusing, render, composite, gl, all)"
+                "unknown area `{other}` (known: traversal, grin, octree, schlieren, noise, bos, focusing, render, composite, unstructured, gl, all)"
             )),
         };
         match result {
