@@ -13,7 +13,7 @@ use rt_volume::io::read_grid;
 
 use crate::{
     image,
-    optics::{Axis, Interpolation, Samples, Volume},
+    optics::{Axis, Interpolation, Samples, Source, Volume},
     parse,
 };
 

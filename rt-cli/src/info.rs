@@ -7,7 +7,7 @@ use rt_photo::{Cutoff, Mode};
 use rt_surface::io::{MeshData, read_mesh};
 use rt_volume::{Grid, io::read_grid};
 
-use crate::optics::{Axis, Interpolation, Samples, Volume};
+use crate::optics::{Axis, Interpolation, Samples, Source, Volume};
 
 /// `rt info FILE`: options.
 #[derive(Debug, clap::Args)]

@@ -7,10 +7,14 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::ValueEnum;
+use rt_photo::UnstructuredField;
 use rt_photo::{
     Bench, Cutoff, Film, Filter, Mode, Octree, Reconstruction, TraceParams, Weighting, build_octree,
 };
-use rt_volume::{GLADSTONE_DALE_AIR, Grid, GridField, Interp, gladstone_dale, glam::DVec3};
+use rt_volume::{
+    Bounds, GLADSTONE_DALE_AIR, Grid, GridField, Interp, gladstone_dale, glam::DVec3,
+    io::UnstructuredData,
+};
 
 use crate::progress;
 
@@ -131,13 +135,86 @@ impl Volume {
         Self::new(grid, Quantity::Density, GLADSTONE_DALE_AIR, false, interp)
     }
 
+    /// The trace settings for a grid: leapfrog with steps of two cells,
+    /// the report's `rt-2voxel` setting, which reaches the same image error
+    /// as one-cell steps 1.3× faster (`rt-report schlieren`).
+    fn grid_params(&self) -> TraceParams {
+        let base = TraceParams::for_grid(&self.field);
+        TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base }
+    }
+}
+
+/// A volume read from an unstructured mesh (`.vtu`, or a legacy `.vtk`
+/// unstructured grid), traced exactly cell by cell.
+#[derive(Debug)]
+pub struct MeshVolume {
+    /// The index field.
+    pub field: UnstructuredField,
+}
+
+impl MeshVolume {
+    /// The mesh `data` holds as `quantity`, mapped to index as
+    /// [`Volume::new`] maps a grid's samples; the index outside is that
+    /// of its first point.
+    ///
+    /// # Errors
+    /// Non-physical values unless `allow_nonphysical`; a bad mesh.
+    pub fn new(
+        data: UnstructuredData,
+        quantity: Quantity,
+        k: f64,
+        allow_nonphysical: bool,
+    ) -> anyhow::Result<Self> {
+        let lowest = data.values.iter().copied().fold(f64::INFINITY, f64::min);
+        let (bad, what) = match quantity {
+            Quantity::Density => (lowest <= 0.0, "density ≤ 0 kg/m³"),
+            Quantity::Index => (lowest < 1.0, "index below 1"),
+        };
+        if bad && !allow_nonphysical {
+            bail!(
+                "the mesh holds a {what} (lowest value {lowest} in array {:?}); check --quantity, or pass --allow-nonphysical",
+                data.array
+            );
+        }
+        if quantity == Quantity::Density && !(k.is_finite() && k > 0.0) {
+            bail!("the Gladstone–Dale constant must be finite and > 0 (got {k})");
+        }
+        let index: Vec<f64> = match quantity {
+            Quantity::Density => data.values.iter().map(|&rho| gladstone_dale(rho, k)).collect(),
+            Quantity::Index => data.values,
+        };
+        let ambient = index.first().copied().unwrap_or(1.0);
+        let field = UnstructuredField::new(data.points, &data.cells, index, ambient)?;
+        Ok(Self { field })
+    }
+}
+
+/// What the bench looks through: a gridded [`Volume`] or a [`MeshVolume`].
+pub trait Source {
+    /// The box the field fills.
+    fn bounds(&self) -> Bounds;
+    /// The undisturbed index (interferometry's reference).
+    fn n_ref(&self) -> f64;
+    /// The trace settings the bench carries.
+    fn params(&self) -> TraceParams;
+    /// One pass of `bench` onto `film` on the field's fast path.
+    ///
+    /// # Errors
+    /// A failing trace.
+    fn pass(&self, bench: &Bench, film: &mut Film, pass: u64, seed: u64) -> anyhow::Result<()>;
+    /// One pass tracing every step (no skipping), for surveys.
+    ///
+    /// # Errors
+    /// A failing trace.
+    fn probe(&self, bench: &Bench, film: &mut Film) -> anyhow::Result<()>;
+
     /// A bench looking through the whole volume along `axis`: the beam
     /// covers the box's cross-section and starts upstream of it; the optics
     /// image the volume's mid-plane, the film sits `film_distance` behind
     /// it (negative: in front). Mode and film distance are the caller's.
     #[must_use]
-    pub fn bench(&self, axis: Axis, mode: Mode, film_distance: f64) -> Bench {
-        let b = self.field.grid().bounds();
+    fn bench(&self, axis: Axis, mode: Mode, film_distance: f64) -> Bench {
+        let b = self.bounds();
         let (direction, u) = axis.frame();
         let v = direction.cross(u);
         let ext = b.max - b.min;
@@ -158,27 +235,13 @@ impl Volume {
         }
     }
 
-    /// The integrator: leapfrog with steps of two cells, the report's
-    /// `rt-2voxel` setting, which reaches the same image error as one-cell
-    /// steps 1.3× faster (`rt-report schlieren`).
-    fn params(&self) -> TraceParams {
-        let base = TraceParams::for_grid(&self.field);
-        TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base }
-    }
-
-    /// One pass of the bench (`strata²` photons per pixel) onto `film`, on
-    /// the fast path.
-    fn pass(&self, bench: &Bench, film: &mut Film, pass: u64, seed: u64) -> anyhow::Result<()> {
-        Ok(bench.render_grid(&self.field, &self.tree, film, pass, seed)?)
-    }
-
     /// Renders `photons` photons per pixel (rounded up to whole passes of
     /// `strata²`) onto a `width`-wide film, with a progress bar; returns
     /// the film and the seconds it took.
     ///
     /// # Errors
     /// A film too large, or a failing trace.
-    pub fn render(
+    fn render(
         &self,
         bench: &Bench,
         width: usize,
@@ -206,7 +269,7 @@ impl Volume {
     ///
     /// # Errors
     /// As [`Volume::render`].
-    pub fn survey(&self, bench: &Bench) -> anyhow::Result<Survey> {
+    fn survey(&self, bench: &Bench) -> anyhow::Result<Survey> {
         const WIDTH: usize = 96;
         let height = ((WIDTH as f64) * bench.height / bench.width).round().clamp(1.0, 4096.0);
         let mut film = Film::new(WIDTH, height as usize, Filter::Box)?;
@@ -216,12 +279,49 @@ impl Volume {
         // and with the film in the image plane cannot see deflections, so
         // its skipping tolerance (1e-3 rad) would hide every deflection
         // below it, i.e. all of a weak flow's. 96 photons a row: cheap.
-        probe.render(&self.field, &mut film, 0, 0x5eed)?;
+        self.probe(&probe, &mut film)?;
         Ok(Survey {
             eps: film.mean_deflection(),
             width: WIDTH,
             pixel: (bench.width / WIDTH as f64, bench.height / height),
         })
+    }
+}
+
+impl Source for Volume {
+    fn bounds(&self) -> Bounds {
+        self.field.grid().bounds()
+    }
+    fn n_ref(&self) -> f64 {
+        self.field.grid().data().first().map_or(1.0, |&n| f64::from(n))
+    }
+    fn params(&self) -> TraceParams {
+        self.grid_params()
+    }
+    fn pass(&self, bench: &Bench, film: &mut Film, pass: u64, seed: u64) -> anyhow::Result<()> {
+        Ok(bench.render_grid(&self.field, &self.tree, film, pass, seed)?)
+    }
+    fn probe(&self, bench: &Bench, film: &mut Film) -> anyhow::Result<()> {
+        Ok(bench.render(&self.field, film, 0, 0x5eed)?)
+    }
+}
+
+impl Source for MeshVolume {
+    fn bounds(&self) -> Bounds {
+        self.field.bounds()
+    }
+    fn n_ref(&self) -> f64 {
+        self.field.ambient()
+    }
+    fn params(&self) -> TraceParams {
+        // Unused: the mesh is traced in closed form.
+        TraceParams::accurate()
+    }
+    fn pass(&self, bench: &Bench, film: &mut Film, pass: u64, seed: u64) -> anyhow::Result<()> {
+        Ok(bench.render_mesh(&self.field, film, pass, seed)?)
+    }
+    fn probe(&self, bench: &Bench, film: &mut Film) -> anyhow::Result<()> {
+        Ok(bench.render_mesh(&self.field, film, 0, 0x5eed)?)
     }
 }
 

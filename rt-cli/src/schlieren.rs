@@ -7,12 +7,15 @@ use anyhow::{Context, bail};
 use clap::ValueEnum;
 use rt_core::Frame;
 use rt_photo::{Bench, Cutoff, Film, FilterImage, Mode, Reconstruction};
-use rt_volume::{glam::DVec3, io::read_grid};
+use rt_volume::{
+    glam::DVec3,
+    io::{is_unstructured, read_grid, read_unstructured},
+};
 
 use crate::{
     figure::{self, Figure, Legend},
     image,
-    optics::{Axis, Interpolation, Samples, Survey, Volume},
+    optics::{Axis, Interpolation, MeshVolume, Samples, Source, Survey, Volume},
     parse,
 };
 
@@ -41,9 +44,16 @@ pub enum CutoffKind {
 /// `rt schlieren FILE`: options.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The volume: NRRD (.nrrd/.nhdr), raw + JSON sidecar (.json/.raw) or
-    /// VTK image data (.vtk/.vti).
+    /// The volume: NRRD (.nrrd/.nhdr), raw + JSON sidecar (.json/.raw),
+    /// VTK image data (.vtk/.vti), or an unstructured mesh (.vtu, or a
+    /// legacy .vtk UNSTRUCTURED_GRID: tetrahedra, pyramids, wedges,
+    /// hexahedra), traced exactly cell by cell.
     pub file: PathBuf,
+    /// The point- or cell-data array of an unstructured mesh to read
+    /// (default: its first scalar point array, else its first scalar cell
+    /// array, averaged to the points).
+    #[arg(long)]
+    pub array: Option<String>,
     /// What the samples are.
     #[command(flatten)]
     pub samples: Samples,
@@ -196,6 +206,12 @@ fn optics(a: &Args, survey: &Survey, n_ref: f64) -> (Mode, f64, String) {
 /// An unreadable or unsuitable volume, bad optics, too many photons, an
 /// unwritable output.
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    if is_unstructured(&a.file) {
+        let data = read_unstructured(&a.file, a.array.as_deref())?;
+        let mesh = MeshVolume::new(data, a.samples.quantity, a.samples.k, a.allow_nonphysical)
+            .with_context(|| a.file.display().to_string())?;
+        return render(&mesh, a);
+    }
     let grid = read_grid(&a.file)?;
     let volume = Volume::new(grid, a.samples.quantity, a.samples.k, a.allow_nonphysical, a.interp)
         .with_context(|| a.file.display().to_string())?;
@@ -209,7 +225,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 ///
 /// # Errors
 /// Too many photons for one run; a failing survey.
-pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<(Bench, String)> {
+pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<(Bench, String)> {
     let probe = volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
     let height = ((f64::from(a.size)) * probe.height / probe.width).round().max(1.0);
     let photons = u64::from(a.size) * height as u64 * crate::optics::traced_per_pixel(a.photons);
@@ -219,7 +235,7 @@ pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<(Bench, String)> {
         );
     }
     let survey = volume.survey(&probe)?;
-    let n_ref = volume.field.grid().data().first().map_or(1.0, |&n| f64::from(n));
+    let n_ref = volume.n_ref();
     let (mode, film_distance, chosen) = optics(a, &survey, n_ref);
     if let Mode::Interferometry { lambda, fringe_spacing, .. } = mode {
         // Phase step per pixel: the deflection is the phase gradient over k.
@@ -241,7 +257,7 @@ pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<(Bench, String)> {
 ///
 /// # Errors
 /// Bad optics, too many photons, an unwritable output.
-pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
+pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     let (bench, chosen) = prepare(volume, a)?;
     let bench = match a.estimator {
         Estimator::Sheet => bench,
@@ -282,8 +298,8 @@ fn axis_name(d: DVec3) -> &'static str {
 /// The figure of `frame`: axes from the volume's bounds along the image
 /// axes u and v, the mode and optics in the title, the colour filter's
 /// wheel as its legend.
-fn figure(volume: &Volume, a: &Args, bench: &Bench, frame: &Frame, chosen: &str) -> Figure {
-    let b = volume.field.grid().bounds();
+fn figure(volume: &impl Source, a: &Args, bench: &Bench, frame: &Frame, chosen: &str) -> Figure {
+    let b = volume.bounds();
     let v = bench.direction.cross(bench.u);
     // The image spans the box's cross-section: u left to right, v bottom
     // to top (the box's coordinates along each, whatever the axis's sign).

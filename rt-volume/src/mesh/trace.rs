@@ -216,10 +216,13 @@ impl Face {
             if !(next > lo && next < hi) {
                 next = 0.5 * (lo + hi);
             }
-            if next == t || hi - lo <= 4.0 * f64::EPSILON * hi {
+            // Round-off makes the last steps wander by a few ulps: stop there.
+            let done = (next - t).abs() <= 16.0 * f64::EPSILON * t.abs().max(next.abs())
+                || hi - lo <= 16.0 * f64::EPSILON * hi;
+            t = next;
+            if done {
                 break;
             }
-            t = next;
         }
         // Converged to round-off (from either side: a point a rounding
         // error inside the face is left through it by the next cell's
@@ -303,6 +306,10 @@ impl UnstructuredField {
                 return Err(TraceError::BadField { at: x0 });
             }
             let mut tet = tet0;
+            // The last step's cells when it was of no length: a zero step
+            // straight back through the same face is a ray held on it.
+            let mut back: Option<(usize, usize)> = None;
+            let tiny = 1e-9 * (self.bounds.max - self.bounds.min).max_element() / self.range.1;
             let mut cur = x0;
             let mut tt = n0 * dir;
             // Inside the mesh: cell by cell.
@@ -319,8 +326,32 @@ impl UnstructuredField {
                     return Err(TraceError::BadField { at: cur });
                 }
                 tt = unit(tt) * n;
-                let arc = Arc { x0: cur, t0: tt, n0: n, grad, g: grad.length(), k: grad.dot(tt) };
-                let step = self.leave(tet, &arc);
+                let mut arc =
+                    Arc { x0: cur, t0: tt, n0: n, grad, g: grad.length(), k: grad.dot(tt) };
+                let mut step = self.leave(tet, &arc, None);
+                let next = self.neighbors[tet][step.face];
+                if step.t <= tiny && back == Some((next as usize, tet)) {
+                    // Both cells bend the ray into the face between them (a
+                    // ridge of n along it): the ray slides along the face,
+                    // with the gradient's part across it taken out (the
+                    // sliding solution of a piecewise-smooth system), to
+                    // the face's edge.
+                    let (nrm, _) = self.plane(tet, step.face);
+                    let across = nrm.dot(grad) / nrm.length_squared();
+                    let along = grad - across * nrm;
+                    let t_in = tt - nrm.dot(tt) / nrm.length_squared() * nrm;
+                    let t_in = unit(t_in) * n;
+                    arc = Arc {
+                        x0: cur,
+                        t0: t_in,
+                        n0: n,
+                        grad: along,
+                        g: along.length(),
+                        k: along.dot(t_in),
+                    };
+                    step = self.leave(tet, &arc, Some(step.face));
+                }
+                back = (step.t <= tiny).then_some((tet, self.neighbors[tet][step.face] as usize));
                 let (x1, t1, dopl) = arc.at(step.t);
                 if !(x1.is_finite() && t1.is_finite() && dopl.is_finite())
                     || t1 == DVec3::ZERO
@@ -364,7 +395,7 @@ impl UnstructuredField {
     }
 
     /// The face where the arc leaves `tet` first.
-    fn leave(&self, tet: usize, arc: &Arc) -> Step {
+    fn leave(&self, tet: usize, arc: &Arc, exclude: Option<usize>) -> Step {
         let t4 = self.tets[tet];
         // A bound on the time to leave: a catenary inside a convex cell is
         // no longer than the perimeter of its plane section (< π·diameter),
@@ -390,8 +421,18 @@ impl UnstructuredField {
         }
         let guess = if guess.is_finite() && guess > 0.0 { guess } else { diam / arc.n0 };
         let mut best = Step { t: f64::INFINITY, face: 0 };
-        for (i, face) in faces.iter().enumerate() {
-            if let Some(t) = face.exit(arc, guess, cap)
+        // Faces in the order the straight line meets them: the first is
+        // nearly always where the arc leaves, and the others are then only
+        // searched up to its time.
+        let mut order = [0usize, 1, 2, 3];
+        let straight = |f: &Face| if f.b > 0.0 { -f.s0 / f.b } else { f64::INFINITY };
+        order.sort_by(|&a, &b| straight(&faces[a]).total_cmp(&straight(&faces[b])));
+        for i in order {
+            if Some(i) == exclude {
+                continue;
+            }
+            let limit = cap.min(best.t);
+            if let Some(t) = faces[i].exit(arc, guess.min(limit), limit)
                 && t < best.t
             {
                 best = Step { t, face: i };
@@ -467,7 +508,7 @@ impl UnstructuredField {
         let back = -d;
         for _ in 0..2 * self.tets.len() + 64 {
             let arc = Arc { x0: cur, t0: back, n0: 1.0, grad: DVec3::ZERO, g: 0.0, k: 0.0 };
-            let step = self.leave(tet, &arc);
+            let step = self.leave(tet, &arc, None);
             if step.t >= left {
                 return Some(tet);
             }

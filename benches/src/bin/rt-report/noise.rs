@@ -18,7 +18,11 @@ use rt_benches::{
     plot::{Plot, Series, loglog},
     scenes::{knife_bench, sparse_bumps},
 };
-use rt_cli::{demo::blast_wave_with, optics::lattice, schlieren};
+use rt_cli::{
+    demo::blast_wave_with,
+    optics::{Source, lattice},
+    schlieren,
+};
 use rt_photo::{Bench, Film, Filter, Mode, Reconstruction, TraceParams, build_octree};
 
 use crate::{
