@@ -14,7 +14,7 @@ use numpy::{
 };
 use pyo3::prelude::*;
 use rt_cli::{
-    optics::{Axis, Interpolation, Quantity, Samples},
+    optics::{Axis, Interpolation, Quantity, Samples, Source},
     schlieren::{Args, CutoffKind, Estimator, prepare},
 };
 use rt_photo::{Airy, Bench, ImageBackground, Mode, Reconstruction, Sensor};
@@ -102,6 +102,7 @@ pub(crate) fn optics<'py>(
     }
     let args = Args {
         file: PathBuf::new(),
+        array: None,
         samples: Samples { quantity: Quantity::Density, k: GLADSTONE_DALE_AIR },
         allow_nonphysical: false,
         cutoff: parse::<CutoffKind>("cutoff", cutoff)?,

@@ -164,6 +164,13 @@ impl Face {
             // Concave and not rising: never crosses outward.
             return None;
         }
+        // Still inside at `cap`, and (concave) still rising there: a convex
+        // f that crossed outward would stay out, a concave one rising at
+        // `cap` rose all along, so nothing crosses before `cap`. (Most
+        // faces end here once the first exit is known: one evaluation.)
+        if cap.is_finite() && self.f(arc, cap) <= 0.0 && (p > 0.0 || self.df(arc, cap) >= 0.0) {
+            return None;
+        }
         if s0 >= 0.0 {
             // Convex, on or just outside the plane and moving in: the
             // crossing is after the minimum (where f' = 0).
@@ -211,16 +218,18 @@ impl Face {
             if v == 0.0 {
                 return Some(t);
             }
-            let d = slope(t);
-            let mut next = t - v / d;
+            let step = v / slope(t);
+            if step.abs() <= 16.0 * f64::EPSILON * t.abs() {
+                // Converged: the step is round-off (and may well fall
+                // outside the bracket by an ulp).
+                break;
+            }
+            let mut next = t - step;
             if !(next > lo && next < hi) {
                 next = 0.5 * (lo + hi);
             }
-            // Round-off makes the last steps wander by a few ulps: stop there.
-            let done = (next - t).abs() <= 16.0 * f64::EPSILON * t.abs().max(next.abs())
-                || hi - lo <= 16.0 * f64::EPSILON * hi;
             t = next;
-            if done {
+            if hi - lo <= 16.0 * f64::EPSILON * hi {
                 break;
             }
         }
