@@ -71,7 +71,7 @@ pub use field::{Bounds, IndexField};
 pub use grid::{Grid, GridError, GridField, Interp};
 pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
 #[cfg(feature = "mesh")]
-pub use mesh::{Cell, MeshError, UnstructuredField};
+pub use mesh::{Cell, MeshError, SmoothField, UnstructuredField};
 #[cfg(feature = "alloc")]
 pub use skip::{
     BRICK, BeamMask, BeamWindow, MAX_BEAM_CELLS, OctNode, Octree, OctreeError, SmoothNode,
