@@ -26,8 +26,8 @@ use rt_benches::{
     scenes::box_hex_mesh,
 };
 use rt_volume::{
-    Cell, Exit, GaussianBump, Grid, GridField, Interp, TraceError, TraceParams, TraceResult,
-    UnstructuredField, glam::DVec3, trace,
+    Cell, Exit, GaussianBump, Grid, GridField, Interp, SmoothField, TraceError, TraceParams,
+    TraceResult, UnstructuredField, glam::DVec3, trace,
 };
 
 use crate::{
@@ -115,8 +115,9 @@ pub(crate) struct Method {
 }
 
 /// The methods, in the table's order: add one here.
-const METHODS: [Method; 3] = [
+const METHODS: [Method; 4] = [
     Method { name: "tet-exact", build: tet_exact, throughput: true },
+    Method { name: "tet-smooth", build: tet_smooth, throughput: true },
     Method { name: "grid-trilinear", build: grid_trilinear, throughput: false },
     Method { name: "grid-cubic", build: grid_cubic, throughput: false },
 ];
@@ -127,6 +128,17 @@ fn tet_exact(c: &Case) -> Result<Built, String> {
     let field = UnstructuredField::new(c.points.clone(), &c.cells, c.index.clone(), 1.0)
         .map_err(|e| format!("bump-{}: {e}", c.n))?;
     Ok(Built { cells: field.tetrahedra().len(), trace: Box::new(move |o, d| field.trace(o, d)) })
+}
+
+/// `SmoothField` on the same tetrahedra: gradients recovered at the
+/// points, RK4 at half the median edge (`SmoothField::params`).
+fn tet_smooth(c: &Case) -> Result<Built, String> {
+    let mesh = UnstructuredField::new(c.points.clone(), &c.cells, c.index.clone(), 1.0)
+        .map_err(|e| format!("bump-{}: {e}", c.n))?;
+    let cells = mesh.tetrahedra().len();
+    let field = SmoothField::new(mesh);
+    let params = field.params();
+    Ok(Built { cells, trace: Box::new(move |o, d| trace(&field, o, d, &params)) })
 }
 
 /// `GridField` on the lattice, `rt_volume::trace` with
