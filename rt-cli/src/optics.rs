@@ -7,10 +7,10 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::ValueEnum;
-use rt_photo::UnstructuredField;
 use rt_photo::{
     Bench, Cutoff, Film, Filter, Mode, Octree, Reconstruction, TraceParams, Weighting, build_octree,
 };
+use rt_photo::{SmoothField, UnstructuredField};
 use rt_volume::{
     Bounds, GLADSTONE_DALE_AIR, Grid, GridField, Interp, gladstone_dale, glam::DVec3,
     io::UnstructuredData,
@@ -144,12 +144,27 @@ impl Volume {
     }
 }
 
+/// How an unstructured mesh is traced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MeshTrace {
+    /// Exactly through the data's piecewise-linear interpolant, cell by
+    /// cell in closed form (a single ray's deflection is first order in
+    /// the cell size; coarse cells show as facets).
+    Exact,
+    /// Gradients recovered at the points and interpolated, RK4 at half an
+    /// edge: second order per ray and no facets (`rt-report
+    /// unstructured`: 4× less error at 64 cells a side, 1.2× the time).
+    Smooth,
+}
+
 /// A volume read from an unstructured mesh (`.vtu`, or a legacy `.vtk`
-/// unstructured grid), traced exactly cell by cell.
+/// unstructured grid).
 #[derive(Debug)]
-pub struct MeshVolume {
-    /// The index field.
-    pub field: UnstructuredField,
+pub enum MeshVolume {
+    /// Traced exactly cell by cell.
+    Exact(UnstructuredField),
+    /// With recovered gradients, integrated.
+    Smooth(SmoothField),
 }
 
 impl MeshVolume {
@@ -164,6 +179,7 @@ impl MeshVolume {
         quantity: Quantity,
         k: f64,
         allow_nonphysical: bool,
+        how: MeshTrace,
     ) -> anyhow::Result<Self> {
         let lowest = data.values.iter().copied().fold(f64::INFINITY, f64::min);
         let (bad, what) = match quantity {
@@ -185,7 +201,19 @@ impl MeshVolume {
         };
         let ambient = index.first().copied().unwrap_or(1.0);
         let field = UnstructuredField::new(data.points, &data.cells, index, ambient)?;
-        Ok(Self { field })
+        Ok(match how {
+            MeshTrace::Exact => Self::Exact(field),
+            MeshTrace::Smooth => Self::Smooth(SmoothField::new(field)),
+        })
+    }
+
+    /// The mesh.
+    #[must_use]
+    pub fn mesh(&self) -> &UnstructuredField {
+        match self {
+            Self::Exact(f) => f,
+            Self::Smooth(s) => s.mesh(),
+        }
     }
 }
 
@@ -308,20 +336,26 @@ impl Source for Volume {
 
 impl Source for MeshVolume {
     fn bounds(&self) -> Bounds {
-        self.field.bounds()
+        self.mesh().bounds()
     }
     fn n_ref(&self) -> f64 {
-        self.field.ambient()
+        self.mesh().ambient()
     }
     fn params(&self) -> TraceParams {
-        // Unused: the mesh is traced in closed form.
-        TraceParams::accurate()
+        match self {
+            // Unused: the mesh is traced in closed form.
+            Self::Exact(_) => TraceParams::accurate(),
+            Self::Smooth(s) => s.params(),
+        }
     }
     fn pass(&self, bench: &Bench, film: &mut Film, pass: u64, seed: u64) -> anyhow::Result<()> {
-        Ok(bench.render_mesh(&self.field, film, pass, seed)?)
+        match self {
+            Self::Exact(f) => Ok(bench.render_mesh(f, film, pass, seed)?),
+            Self::Smooth(s) => Ok(bench.render(s, film, pass, seed)?),
+        }
     }
     fn probe(&self, bench: &Bench, film: &mut Film) -> anyhow::Result<()> {
-        Ok(bench.render_mesh(&self.field, film, 0, 0x5eed)?)
+        self.pass(bench, film, 0, 0x5eed)
     }
 }
 

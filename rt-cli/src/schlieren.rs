@@ -15,7 +15,7 @@ use rt_volume::{
 use crate::{
     figure::{self, Figure, Legend},
     image,
-    optics::{Axis, Interpolation, MeshVolume, Samples, Source, Survey, Volume},
+    optics::{Axis, Interpolation, MeshTrace, MeshVolume, Samples, Source, Survey, Volume},
     parse,
 };
 
@@ -116,9 +116,12 @@ pub struct Args {
     /// Monte Carlo estimate, for comparison).
     #[arg(long, value_enum, default_value_t = Estimator::Sheet)]
     pub estimator: Estimator,
-    /// Interpolation between samples.
+    /// Interpolation between samples (grids).
     #[arg(long, value_enum, default_value_t = Interpolation::Linear)]
     pub interp: Interpolation,
+    /// How an unstructured mesh is traced.
+    #[arg(long, value_enum, default_value_t = MeshTrace::Exact)]
+    pub mesh: MeshTrace,
     /// Seed of every random choice: the same seed gives the same image.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -208,8 +211,9 @@ fn optics(a: &Args, survey: &Survey, n_ref: f64) -> (Mode, f64, String) {
 pub fn run(a: &Args) -> anyhow::Result<()> {
     if is_unstructured(&a.file) {
         let data = read_unstructured(&a.file, a.array.as_deref())?;
-        let mesh = MeshVolume::new(data, a.samples.quantity, a.samples.k, a.allow_nonphysical)
-            .with_context(|| a.file.display().to_string())?;
+        let mesh =
+            MeshVolume::new(data, a.samples.quantity, a.samples.k, a.allow_nonphysical, a.mesh)
+                .with_context(|| a.file.display().to_string())?;
         return render(&mesh, a);
     }
     let grid = read_grid(&a.file)?;

@@ -107,7 +107,7 @@ pub use sensor::{Sensor, SensorError};
 // `build_octree`, the only way to the `Octree` that `render_grid` takes).
 pub use rt_core::ColorMap;
 #[cfg(feature = "mesh")]
-pub use rt_volume::{Cell, MeshError, UnstructuredField};
+pub use rt_volume::{Cell, MeshError, SmoothField, UnstructuredField};
 pub use rt_volume::{
     GridField, IndexField, Octree, TraceError, TraceParams, TraceResult, build_octree,
 };
