@@ -41,6 +41,7 @@ pub mod scenes;
 pub mod schlieren;
 pub mod text;
 pub mod view;
+pub mod vtu;
 
 use clap::{Parser, Subcommand};
 

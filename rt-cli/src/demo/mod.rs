@@ -29,7 +29,10 @@
 //!   and with the flow) and `bos-displacement.png` (+ `.json`/`.raw`: the
 //!   true displacement in pixels); and focusing schlieren as `rt
 //!   focusing` writes it: `focusing.png` (a lens-and-grid system focused
-//!   on the blast's mid-plane, + `.json`/`.raw`: I/I₀ per pixel).
+//!   on the blast's mid-plane, + `.json`/`.raw`: I/I₀ per pixel); and the
+//!   blast wave as an unstructured mesh (every second sample, 32³
+//!   hexahedra): `blast.vtu`, and `schlieren-mesh.png` (+ `-figure.png`)
+//!   rendered from it as `rt schlieren blast.vtu --mesh smooth` does.
 mod optics;
 
 pub use optics::{blast_wave, blast_wave_with};

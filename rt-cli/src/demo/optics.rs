@@ -7,10 +7,13 @@ use std::path::Path;
 use anyhow::Context;
 use rt_volume::io;
 
+use rt_photo::Cell;
+use rt_volume::{GLADSTONE_DALE_AIR, glam::DVec3};
+
 use crate::{
     bos, focusing,
-    optics::{Interpolation, Volume},
-    schlieren,
+    optics::{Interpolation, MeshTrace, MeshVolume, Quantity, Volume},
+    schlieren, vtu,
 };
 
 const RAW: &[u8] = include_bytes!("../../data/blast_sedov_64.raw");
@@ -64,5 +67,58 @@ pub(crate) fn render_all(out: &Path) -> anyhow::Result<()> {
     let mut a = focusing::Args::from_args(Path::new("built-in"), ["--size", "384"])?;
     a.out = out.join("focusing.png");
     focusing::render(&volume, &a).context("focusing.png")?;
+    // The blast wave as an unstructured mesh: written as `blast.vtu` (for
+    // the user to try `rt schlieren out/blast.vtu` and ParaView on), read
+    // back, and rendered exactly as `rt schlieren` renders a user's mesh.
+    let vtu = out.join("blast.vtu");
+    let (points, cells, density) = blast_mesh()?;
+    vtu::write_vtu(&vtu, &points, &cells, "density", &density)?;
+    let data = io::read_unstructured(&vtu, None).context("blast.vtu")?;
+    let mesh =
+        MeshVolume::new(data, Quantity::Density, GLADSTONE_DALE_AIR, false, MeshTrace::Smooth)?;
+    let args = ["--cutoff", "knife", "--size", "256", "--photons", "4", "--mesh", "smooth"];
+    let mut a = schlieren::Args::from_args(&vtu, args)?;
+    a.out = out.join("schlieren-mesh.png");
+    schlieren::render(&mesh, &a).context("schlieren-mesh.png")?;
     Ok(())
+}
+
+/// The built-in blast wave's density on every second sample, as the
+/// points and hexahedra of an unstructured mesh (33³ points, 32³ cells).
+fn blast_mesh() -> anyhow::Result<(Vec<DVec3>, Vec<Cell>, Vec<f64>)> {
+    let header: serde_json::Value = serde_json::from_str(JSON).context("built-in JSON header")?;
+    let grid = io::parse_raw_json(&header, RAW).context("built-in blast wave")?;
+    let [nx, ny, nz] = grid.dims().map(|d| d.div_ceil(2));
+    let (o, h) = (grid.origin(), grid.spacing());
+    let [gx, gy, _] = grid.dims();
+    let mut points = Vec::with_capacity(nx * ny * nz);
+    let mut density = Vec::with_capacity(nx * ny * nz);
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let (a, b, c) = (2 * i, 2 * j, 2 * k);
+                points.push(o + h * DVec3::new(a as f64, b as f64, c as f64));
+                density.push(f64::from(grid.data()[a + gx * (b + gy * c)]));
+            }
+        }
+    }
+    let id = |i: usize, j: usize, k: usize| (i + nx * (j + ny * k)) as u32;
+    let mut cells = Vec::with_capacity((nx - 1) * (ny - 1) * (nz - 1));
+    for k in 0..nz - 1 {
+        for j in 0..ny - 1 {
+            for i in 0..nx - 1 {
+                cells.push(Cell::Hexahedron([
+                    id(i, j, k),
+                    id(i + 1, j, k),
+                    id(i + 1, j + 1, k),
+                    id(i, j + 1, k),
+                    id(i, j, k + 1),
+                    id(i + 1, j, k + 1),
+                    id(i + 1, j + 1, k + 1),
+                    id(i, j + 1, k + 1),
+                ]));
+            }
+        }
+    }
+    Ok((points, cells, density))
 }
