@@ -9,21 +9,24 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use rt_photo::{
     Background, Bos, DotBackground, DotGrid, FilterImage, ImageBackground, Sensor, ThinLens,
-    TraceParams,
 };
-use rt_volume::io::read_grid;
+use rt_volume::io::{is_unstructured, read_grid};
 
 use crate::{
     image,
-    optics::{Axis, Interpolation, Samples, Volume},
+    optics::{Axis, Interpolation, MeshOptions, Samples, Source, Volume},
     parse,
 };
 
 /// `rt bos FILE`: options.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The volume: NRRD, raw + JSON sidecar or VTK image data.
+    /// The volume: NRRD, raw + JSON sidecar, VTK image data, or an
+    /// unstructured mesh (.vtu, legacy .vtk UNSTRUCTURED_GRID).
     pub file: PathBuf,
+    /// How an unstructured mesh is read and traced.
+    #[command(flatten)]
+    pub mesh: MeshOptions,
     /// What the samples are.
     #[command(flatten)]
     pub samples: Samples,
@@ -114,6 +117,10 @@ pub struct Args {
 /// # Errors
 /// An unreadable or unsuitable volume, a bad set-up, an unwritable output.
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    if is_unstructured(&a.file) {
+        let mesh = a.mesh.load(&a.file, a.samples, false)?;
+        return render(&mesh, a).map(drop);
+    }
     let grid = read_grid(&a.file)?;
     let volume = Volume::new(grid, a.samples.quantity, a.samples.k, false, a.interp)
         .with_context(|| a.file.display().to_string())?;
@@ -125,14 +132,14 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 ///
 /// # Errors
 /// A bad set-up or an unwritable output.
-pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
+pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     let t = std::time::Instant::now();
     let bos = prepare(volume, a)?;
     let camera = bos.camera;
     let (w, h) = (camera.width, camera.height);
     let (f, z_a) = (camera.focal_length, a.distance_or_default(volume));
     let z_d = camera.focus_distance - z_a;
-    let images = bos.render_grid(&volume.field, &volume.tree, a.seed)?;
+    let images = volume.bos(&bos, a.seed)?;
     let sensor = Sensor {
         exposure: a.exposure,
         full_well: a.full_well,
@@ -213,8 +220,8 @@ pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<()> {
 /// # Errors
 /// The volume closer to the lens than its focal length, an unreadable
 /// background image, or a bad set-up.
-pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<Bos> {
-    let b = volume.field.grid().bounds();
+pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<Bos> {
+    let b = volume.bounds();
     let (axis, u) = a.axis.frame();
     let v = axis.cross(u);
     let ext = b.max - b.min;
@@ -237,7 +244,6 @@ pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<Bos> {
         width: w,
         height: h,
     };
-    let base = TraceParams::for_grid(&volume.field);
     let background: Background = match &a.background {
         BackgroundChoice::Random => {
             DotBackground::for_camera(&camera, a.dot, a.spacing, a.seed).into()
@@ -256,7 +262,7 @@ pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<Bos> {
         background_distance: z_a + z_d,
         background,
         aperture_samples: a.samples_per_axis,
-        params: TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base },
+        params: volume.params(),
     };
     bos.validate()?;
     Ok(bos)
@@ -287,8 +293,8 @@ impl Args {
     /// `--distance`, or the default: the volume's width across the image
     /// (and a 5 % margin) fills the sensor at the volume's centre.
     #[must_use]
-    pub fn distance_or_default(&self, volume: &Volume) -> f64 {
-        let b = volume.field.grid().bounds();
+    pub fn distance_or_default(&self, volume: &impl Source) -> f64 {
+        let b = volume.bounds();
         let (_, u) = self.axis.frame();
         let f = self.focal_length;
         self.distance

@@ -6,22 +6,24 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use rt_photo::{
-    Cutoff, FocusingImages, FocusingSchlieren, Mode, Sensor, SourceGrid, ThinLens, TraceParams,
-};
-use rt_volume::io::read_grid;
+use rt_photo::{Cutoff, FocusingImages, FocusingSchlieren, Mode, Sensor, SourceGrid, ThinLens};
+use rt_volume::io::{is_unstructured, read_grid};
 
 use crate::{
     image,
-    optics::{Axis, Interpolation, Samples, Source, Volume},
+    optics::{Axis, Interpolation, MeshOptions, Samples, Source, Volume},
     parse,
 };
 
 /// `rt focusing FILE`: options.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The volume: NRRD, raw + JSON sidecar or VTK image data.
+    /// The volume: NRRD, raw + JSON sidecar, VTK image data, or an
+    /// unstructured mesh (.vtu, legacy .vtk UNSTRUCTURED_GRID).
     pub file: PathBuf,
+    /// How an unstructured mesh is read and traced.
+    #[command(flatten)]
+    pub mesh: MeshOptions,
     /// What the samples are.
     #[command(flatten)]
     pub samples: Samples,
@@ -116,6 +118,10 @@ pub struct Args {
 /// # Errors
 /// An unreadable or unsuitable volume, a bad set-up, an unwritable output.
 pub fn run(a: &Args) -> anyhow::Result<()> {
+    if is_unstructured(&a.file) {
+        let mesh = a.mesh.load(&a.file, a.samples, false)?;
+        return render(&mesh, a).map(drop);
+    }
     let grid = read_grid(&a.file)?;
     let volume = Volume::new(grid, a.samples.quantity, a.samples.k, false, a.interp)
         .with_context(|| a.file.display().to_string())?;
@@ -127,12 +133,12 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 ///
 /// # Errors
 /// A bad set-up or an unwritable output.
-pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<FocusingImages> {
+pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<FocusingImages> {
     let t = std::time::Instant::now();
     let fs = prepare(volume, a)?;
     let cam = fs.camera;
     let (w, h) = (cam.width, cam.height);
-    let images = fs.render_grid(&volume.field, &volume.tree, a.seed)?;
+    let images = volume.focusing(&fs, a.seed)?;
     let relative = images.relative();
     // The sensor records the light, scaled so that the undisturbed
     // background (the mean over the pixels the source lights) collects
@@ -191,8 +197,8 @@ pub fn render(volume: &Volume, a: &Args) -> anyhow::Result<FocusingImages> {
 /// # Errors
 /// The focus plane closer to the lens than its focal length, the source
 /// grid not beyond it, or a bad set-up.
-pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<FocusingSchlieren> {
-    let b = volume.field.grid().bounds();
+pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<FocusingSchlieren> {
+    let b = volume.bounds();
     let (axis, u) = a.axis.frame();
     let v = axis.cross(u);
     let ext = b.max - b.min;
@@ -247,14 +253,13 @@ pub fn prepare(volume: &Volume, a: &Args) -> anyhow::Result<FocusingSchlieren> {
             }
         }
     };
-    let base = TraceParams::for_grid(&volume.field);
     let fs = FocusingSchlieren {
         camera,
         source_distance: z_s,
         grid: SourceGrid { pitch, duty: a.duty, angle, bands: a.bands },
         cutoff_offset: a.offset,
         aperture_samples: a.samples_per_axis,
-        params: TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base },
+        params: volume.params(),
     };
     fs.validate()?;
     Ok(fs)

@@ -8,7 +8,8 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use clap::ValueEnum;
 use rt_photo::{
-    Bench, Cutoff, Film, Filter, Mode, Octree, Reconstruction, TraceParams, Weighting, build_octree,
+    Bench, Bos, BosImages, Cutoff, Film, Filter, FocusingImages, FocusingSchlieren, Mode, Octree,
+    Reconstruction, TraceParams, Weighting, build_octree,
 };
 use rt_photo::{SmoothField, UnstructuredField};
 use rt_volume::{
@@ -157,6 +158,43 @@ pub enum MeshTrace {
     Smooth,
 }
 
+/// How `rt schlieren`, `rt bos` and `rt focusing` read an unstructured mesh.
+#[derive(Clone, Debug, clap::Args)]
+pub struct MeshOptions {
+    /// The point- or cell-data array of an unstructured mesh to read
+    /// (default: its first scalar point array, else its first scalar cell
+    /// array, averaged to the points).
+    #[arg(long)]
+    pub array: Option<String>,
+    /// How an unstructured mesh is traced.
+    #[arg(long, value_enum, default_value_t = MeshTrace::Exact)]
+    pub mesh: MeshTrace,
+}
+
+impl Default for MeshOptions {
+    fn default() -> Self {
+        Self { array: None, mesh: MeshTrace::Exact }
+    }
+}
+
+impl MeshOptions {
+    /// Reads the mesh `file` and maps its values as `samples` says.
+    ///
+    /// # Errors
+    /// An unreadable file, non-physical values unless `allow_nonphysical`,
+    /// a bad mesh; each naming the file.
+    pub fn load(
+        &self,
+        file: &std::path::Path,
+        samples: Samples,
+        allow_nonphysical: bool,
+    ) -> anyhow::Result<MeshVolume> {
+        let data = rt_volume::io::read_unstructured(file, self.array.as_deref())?;
+        MeshVolume::new(data, samples.quantity, samples.k, allow_nonphysical, self.mesh)
+            .with_context(|| file.display().to_string())
+    }
+}
+
 /// A volume read from an unstructured mesh (`.vtu`, or a legacy `.vtk`
 /// unstructured grid).
 #[derive(Debug)]
@@ -235,6 +273,16 @@ pub trait Source {
     /// # Errors
     /// A failing trace.
     fn probe(&self, bench: &Bench, film: &mut Film) -> anyhow::Result<()>;
+    /// The BOS images of `bos` on the field's fast path.
+    ///
+    /// # Errors
+    /// A failing trace or a bad set-up.
+    fn bos(&self, bos: &Bos, seed: u64) -> anyhow::Result<BosImages>;
+    /// The focusing-schlieren images of `fs` on the field's fast path.
+    ///
+    /// # Errors
+    /// A failing trace or a bad set-up.
+    fn focusing(&self, fs: &FocusingSchlieren, seed: u64) -> anyhow::Result<FocusingImages>;
 
     /// A bench looking through the whole volume along `axis`: the beam
     /// covers the box's cross-section and starts upstream of it; the optics
@@ -332,6 +380,12 @@ impl Source for Volume {
     fn probe(&self, bench: &Bench, film: &mut Film) -> anyhow::Result<()> {
         Ok(bench.render(&self.field, film, 0, 0x5eed)?)
     }
+    fn bos(&self, bos: &Bos, seed: u64) -> anyhow::Result<BosImages> {
+        Ok(bos.render_grid(&self.field, &self.tree, seed)?)
+    }
+    fn focusing(&self, fs: &FocusingSchlieren, seed: u64) -> anyhow::Result<FocusingImages> {
+        Ok(fs.render_grid(&self.field, &self.tree, seed)?)
+    }
 }
 
 impl Source for MeshVolume {
@@ -356,6 +410,18 @@ impl Source for MeshVolume {
     }
     fn probe(&self, bench: &Bench, film: &mut Film) -> anyhow::Result<()> {
         self.pass(bench, film, 0, 0x5eed)
+    }
+    fn bos(&self, bos: &Bos, seed: u64) -> anyhow::Result<BosImages> {
+        match self {
+            Self::Exact(f) => Ok(bos.render_mesh(f, seed)?),
+            Self::Smooth(s) => Ok(bos.render(s, seed)?),
+        }
+    }
+    fn focusing(&self, fs: &FocusingSchlieren, seed: u64) -> anyhow::Result<FocusingImages> {
+        match self {
+            Self::Exact(f) => Ok(fs.render_mesh(f, seed)?),
+            Self::Smooth(s) => Ok(fs.render(s, seed)?),
+        }
     }
 }
 

@@ -9,13 +9,13 @@ use rt_core::Frame;
 use rt_photo::{Bench, Cutoff, Film, FilterImage, Mode, Reconstruction};
 use rt_volume::{
     glam::DVec3,
-    io::{is_unstructured, read_grid, read_unstructured},
+    io::{is_unstructured, read_grid},
 };
 
 use crate::{
     figure::{self, Figure, Legend},
     image,
-    optics::{Axis, Interpolation, MeshTrace, MeshVolume, Samples, Source, Survey, Volume},
+    optics::{Axis, Interpolation, MeshOptions, Samples, Source, Survey, Volume},
     parse,
 };
 
@@ -49,11 +49,6 @@ pub struct Args {
     /// legacy .vtk UNSTRUCTURED_GRID: tetrahedra, pyramids, wedges,
     /// hexahedra), traced exactly cell by cell.
     pub file: PathBuf,
-    /// The point- or cell-data array of an unstructured mesh to read
-    /// (default: its first scalar point array, else its first scalar cell
-    /// array, averaged to the points).
-    #[arg(long)]
-    pub array: Option<String>,
     /// What the samples are.
     #[command(flatten)]
     pub samples: Samples,
@@ -119,9 +114,9 @@ pub struct Args {
     /// Interpolation between samples (grids).
     #[arg(long, value_enum, default_value_t = Interpolation::Linear)]
     pub interp: Interpolation,
-    /// How an unstructured mesh is traced.
-    #[arg(long, value_enum, default_value_t = MeshTrace::Exact)]
-    pub mesh: MeshTrace,
+    /// How an unstructured mesh is read and traced.
+    #[command(flatten)]
+    pub mesh: MeshOptions,
     /// Seed of every random choice: the same seed gives the same image.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -210,11 +205,7 @@ fn optics(a: &Args, survey: &Survey, n_ref: f64) -> (Mode, f64, String) {
 /// unwritable output.
 pub fn run(a: &Args) -> anyhow::Result<()> {
     if is_unstructured(&a.file) {
-        let data = read_unstructured(&a.file, a.array.as_deref())?;
-        let mesh =
-            MeshVolume::new(data, a.samples.quantity, a.samples.k, a.allow_nonphysical, a.mesh)
-                .with_context(|| a.file.display().to_string())?;
-        return render(&mesh, a);
+        return render(&a.mesh.load(&a.file, a.samples, a.allow_nonphysical)?, a);
     }
     let grid = read_grid(&a.file)?;
     let volume = Volume::new(grid, a.samples.quantity, a.samples.k, a.allow_nonphysical, a.interp)

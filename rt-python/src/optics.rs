@@ -14,7 +14,7 @@ use numpy::{
 };
 use pyo3::prelude::*;
 use rt_cli::{
-    optics::{Axis, Interpolation, MeshTrace, Quantity, Samples, Source},
+    optics::{Axis, Interpolation, MeshOptions, Quantity, Samples, Source},
     schlieren::{Args, CutoffKind, Estimator, prepare},
 };
 use rt_photo::{Airy, Bench, ImageBackground, Mode, Reconstruction, Sensor};
@@ -119,7 +119,7 @@ pub(crate) fn optics<'py>(
         photons,
         estimator: parse::<Estimator>("estimator", estimator)?,
         interp: Interpolation::Linear,
-        mesh: MeshTrace::Exact,
+        mesh: MeshOptions::default(),
         seed,
         out: PathBuf::new(),
         figure: false,
