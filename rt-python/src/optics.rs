@@ -102,7 +102,6 @@ pub(crate) fn optics<'py>(
     }
     let args = Args {
         file: PathBuf::new(),
-        array: None,
         samples: Samples { quantity: Quantity::Density, k: GLADSTONE_DALE_AIR },
         allow_nonphysical: false,
         cutoff: parse::<CutoffKind>("cutoff", cutoff)?,
