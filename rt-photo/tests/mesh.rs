@@ -22,24 +22,7 @@ fn mesh(n: usize, lo: f64, hi: f64, f: &impl Fn(DVec3) -> f64) -> UnstructuredFi
             }
         }
     }
-    let id = |i: usize, j: usize, k: usize| (i + n * (j + n * k)) as u32;
-    let mut cells = Vec::new();
-    for k in 0..n - 1 {
-        for j in 0..n - 1 {
-            for i in 0..n - 1 {
-                cells.push(Cell::Hexahedron([
-                    id(i, j, k),
-                    id(i + 1, j, k),
-                    id(i + 1, j + 1, k),
-                    id(i, j + 1, k),
-                    id(i, j, k + 1),
-                    id(i + 1, j, k + 1),
-                    id(i + 1, j + 1, k + 1),
-                    id(i, j + 1, k + 1),
-                ]));
-            }
-        }
-    }
+    let cells = Cell::lattice_hexahedra([n; 3]);
     let values = points.iter().map(|&p| f(p)).collect();
     UnstructuredField::new(points, &cells, values, 1.0).unwrap()
 }

@@ -417,3 +417,25 @@ fn smooth_option_recovers_linear_fields_exactly() {
     let y = (n0 / g) * ((g * 2.0 / n0).cosh() - 1.0);
     assert!((r.position - DVec3::new(2.0, y, 0.1)).length() < 1e-7, "{} vs {y}", r.position);
 }
+
+/// A structured lattice's hexahedra: `(n−1)³` cells whose split meets face
+/// to face (the boundary is the box's, two triangles per lattice face).
+#[test]
+fn lattice_hexahedra_tile_the_box() {
+    let dims = [4, 3, 5];
+    let cells = Cell::lattice_hexahedra(dims);
+    assert_eq!(cells.len(), 3 * 2 * 4);
+    assert!(Cell::lattice_hexahedra([1, 5, 5]).is_empty());
+    let mut points = Vec::new();
+    for k in 0..5 {
+        for j in 0..3 {
+            for i in 0..4 {
+                points.push(DVec3::new(i as f64, j as f64, k as f64));
+            }
+        }
+    }
+    let n = points.len();
+    let field = UnstructuredField::new(points, &cells, vec![1.0; n], 1.0).unwrap();
+    assert_eq!(field.boundary_faces(), box_boundary_triangles([3, 2, 4]));
+    assert_eq!(field.tetrahedra().len(), 6 * cells.len());
+}

@@ -102,23 +102,6 @@ fn blast_mesh() -> anyhow::Result<(Vec<DVec3>, Vec<Cell>, Vec<f64>)> {
             }
         }
     }
-    let id = |i: usize, j: usize, k: usize| (i + nx * (j + ny * k)) as u32;
-    let mut cells = Vec::with_capacity((nx - 1) * (ny - 1) * (nz - 1));
-    for k in 0..nz - 1 {
-        for j in 0..ny - 1 {
-            for i in 0..nx - 1 {
-                cells.push(Cell::Hexahedron([
-                    id(i, j, k),
-                    id(i + 1, j, k),
-                    id(i + 1, j + 1, k),
-                    id(i, j + 1, k),
-                    id(i, j, k + 1),
-                    id(i + 1, j, k + 1),
-                    id(i + 1, j + 1, k + 1),
-                    id(i, j + 1, k + 1),
-                ]));
-            }
-        }
-    }
+    let cells = Cell::lattice_hexahedra([nx, ny, nz]);
     Ok((points, cells, density))
 }

@@ -56,6 +56,34 @@ impl Cell {
         }
     }
 
+    /// The hexahedra of a structured lattice of `dims` points a side,
+    /// numbered x fastest (`i + nx·(j + ny·k)`, as grids store their
+    /// samples): a structured grid's points made into an unstructured mesh.
+    /// Empty if any side has fewer than two points.
+    #[must_use]
+    pub fn lattice_hexahedra(dims: [usize; 3]) -> alloc::vec::Vec<Self> {
+        let [nx, ny, nz] = dims;
+        let id = |i: usize, j: usize, k: usize| (i + nx * (j + ny * k)) as u32;
+        let mut cells = alloc::vec::Vec::new();
+        for k in 0..nz.saturating_sub(1) {
+            for j in 0..ny.saturating_sub(1) {
+                for i in 0..nx.saturating_sub(1) {
+                    cells.push(Self::Hexahedron([
+                        id(i, j, k),
+                        id(i + 1, j, k),
+                        id(i + 1, j + 1, k),
+                        id(i, j + 1, k),
+                        id(i, j, k + 1),
+                        id(i + 1, j, k + 1),
+                        id(i + 1, j + 1, k + 1),
+                        id(i, j + 1, k + 1),
+                    ]));
+                }
+            }
+        }
+        cells
+    }
+
     /// VTK's cell type number (10, 14, 13, 12).
     #[must_use]
     pub fn vtk_type(&self) -> u8 {
