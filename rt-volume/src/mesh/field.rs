@@ -48,6 +48,11 @@ pub struct UnstructuredField {
     pub(crate) ambient: f64,
     /// Smallest and largest `n` at the points.
     pub(crate) range: (f64, f64),
+    /// Per tetrahedron, a bound on the parameter `t` a ray can spend in it:
+    /// a catenary inside a convex cell is shorter than the perimeter of
+    /// the plane section it lies in (< π·diameter), and moves at
+    /// `ds/dt = n ≥` the cell's smallest `n`; `4·diameter/n_min`, rounded up.
+    pub(crate) reach: Vec<f32>,
 }
 
 /// The face's normal `(p_b − p_a) × (p_c − p_a)` for its points sorted by
@@ -122,6 +127,16 @@ impl UnstructuredField {
         let bvh = boundary_bvh(&points, &tets, &boundary, shift)?;
         let range =
             index.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &n| (lo.min(n), hi.max(n)));
+        let reach = tets
+            .iter()
+            .map(|t| {
+                let p = t.map(|i| points[i as usize]);
+                let n_min = t.iter().map(|&i| index[i as usize]).fold(f64::INFINITY, f64::min);
+                let r = (4.0 * longest_edge(p) / n_min) as f32;
+                // Rounded up (and never 0 or NaN: the cell has volume).
+                if r.is_finite() { f32::from_bits(r.to_bits() + 1) } else { f32::MAX }
+            })
+            .collect();
         Ok(Self {
             points,
             index,
@@ -136,6 +151,7 @@ impl UnstructuredField {
             bounds,
             ambient,
             range,
+            reach,
         })
     }
 

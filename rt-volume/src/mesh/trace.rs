@@ -51,36 +51,42 @@ use rt_core::Ray;
 use super::field::{NONE, UnstructuredField};
 use crate::{Exit, TraceError, TraceResult, TraceStats};
 
+/// `1/k!` for `k = 0..=15`.
+const INV_FACT: [f64; 16] = {
+    let mut t = [1.0f64; 16];
+    let mut k = 1;
+    while k < 16 {
+        t[k] = t[k - 1] / k as f64;
+        k += 1;
+    }
+    t
+};
+
 /// `sinh(u)/u`, `(cosh(u) − 1)/u²`, `(sinh(u) − u)/u³`.
 #[inline]
 fn hyper(u: f64) -> (f64, f64, f64) {
     let v = u * u;
+    if v < 1e-6 {
+        // |u| < 1e-3 (nearly every cell of a weak flow): three terms, the
+        // next below 1e-21 relative.
+        return (
+            1.0 + v * (INV_FACT[3] + v * INV_FACT[5]),
+            INV_FACT[2] + v * (INV_FACT[4] + v * INV_FACT[6]),
+            INV_FACT[3] + v * (INV_FACT[5] + v * INV_FACT[7]),
+        );
+    }
     if v < 0.25 {
-        // Taylor series, exact to f64 for |u| < 0.5 (the next terms are
-        // below 1e-17 relative).
-        let s = 1.0
-            + v / 6.0
-                * (1.0
-                    + v / 20.0
-                        * (1.0
-                            + v / 42.0 * (1.0 + v / 72.0 * (1.0 + v / 110.0 * (1.0 + v / 156.0)))));
-        let c = 0.5
-            * (1.0
-                + v / 12.0
-                    * (1.0
-                        + v / 30.0
-                            * (1.0
-                                + v / 56.0
-                                    * (1.0 + v / 90.0 * (1.0 + v / 132.0 * (1.0 + v / 182.0))))));
-        let m = (1.0
-            + v / 20.0
-                * (1.0
-                    + v / 42.0
-                        * (1.0
-                            + v / 72.0
-                                * (1.0 + v / 110.0 * (1.0 + v / 156.0 * (1.0 + v / 210.0))))))
-            / 6.0;
-        (s, c, m)
+        // Taylor series in v = u², exact to f64 for |u| < 0.5 (the next
+        // terms are below 1e-17 relative): Σ vᵏ/(2k+1)!, Σ vᵏ/(2k+2)!,
+        // Σ vᵏ/(2k+3)!.
+        let series = |first: usize| {
+            let mut acc = 0.0;
+            for k in (0..7).rev() {
+                acc = acc * v + INV_FACT[first + 2 * k];
+            }
+            acc
+        };
+        (series(1), series(2), series(3))
     } else {
         let sh = u.sinh();
         let half = (0.5 * u).sinh();
@@ -191,10 +197,12 @@ impl Face {
         let slope = |t: f64| if derivative { self.p * arc.n_at(t) } else { self.df(arc, t) };
         let mut lo = lo;
         let mut hi = if start > lo { start } else { lo + cap * 1e-3 };
-        loop {
+        // The values at the bracket's ends, where known.
+        let mut v_lo = f64::NEG_INFINITY;
+        let v_hi = loop {
             let v = eval(hi);
             if v > 0.0 {
-                break;
+                break v;
             }
             if !derivative && self.p < 0.0 && self.df(arc, hi) <= 0.0 {
                 // Concave, past its maximum without crossing.
@@ -203,13 +211,14 @@ impl Face {
             if hi >= cap || !v.is_finite() {
                 return None;
             }
-            lo = hi;
+            (lo, v_lo) = (hi, v);
             hi = (2.0 * hi).min(cap);
-        }
-        // Safeguarded Newton in [lo, hi] with f(lo) ≤ 0 < f(hi).
-        let mut t = hi;
+        };
+        // Safeguarded Newton in [lo, hi] with f(lo) ≤ 0 < f(hi), from the
+        // end nearer the root (the straight-line guess is usually within
+        // round-off of it in a weak field).
+        let (mut t, mut v) = if -v_lo < v_hi { (lo, v_lo) } else { (hi, v_hi) };
         for _ in 0..100 {
-            let v = eval(t);
             if v > 0.0 {
                 hi = t;
             } else {
@@ -232,6 +241,7 @@ impl Face {
             if hi - lo <= 16.0 * f64::EPSILON * hi {
                 break;
             }
+            v = eval(t);
         }
         // Converged to round-off (from either side: a point a rounding
         // error inside the face is left through it by the next cell's
@@ -406,19 +416,8 @@ impl UnstructuredField {
     /// The face where the arc leaves `tet` first.
     fn leave(&self, tet: usize, arc: &Arc, exclude: Option<usize>) -> Step {
         let t4 = self.tets[tet];
-        // A bound on the time to leave: a catenary inside a convex cell is
-        // no longer than the perimeter of its plane section (< π·diameter),
-        // and the ray moves at `ds/dt = n ≥ the cell's smallest n`.
-        let mut diam = 0.0f64;
-        let mut nmin = f64::INFINITY;
-        for i in 0..4 {
-            let pi = self.points[t4[i] as usize];
-            nmin = nmin.min(self.index[t4[i] as usize]);
-            for &j in &t4[i + 1..] {
-                diam = diam.max((pi - self.points[j as usize]).length());
-            }
-        }
-        let cap = 4.0 * diam / nmin;
+        // A bound on the time to leave (see `UnstructuredField::reach`).
+        let cap = f64::from(self.reach[tet]);
         let mut faces = [Face { s0: 0.0, b: 0.0, p: 0.0 }; 4];
         let mut guess = f64::INFINITY;
         for (i, face) in faces.iter_mut().enumerate() {
@@ -428,7 +427,7 @@ impl UnstructuredField {
                 guess = guess.min((-face.s0 / face.b).max(0.0));
             }
         }
-        let guess = if guess.is_finite() && guess > 0.0 { guess } else { diam / arc.n0 };
+        let guess = if guess.is_finite() && guess > 0.0 { guess } else { 0.25 * cap };
         let mut best = Step { t: f64::INFINITY, face: 0 };
         // Faces in the order the straight line meets them: the first is
         // nearly always where the arc leaves, and the others are then only
@@ -537,4 +536,33 @@ impl UnstructuredField {
 fn unit(v: DVec3) -> DVec3 {
     let l2 = v.length_squared();
     if l2.is_normal() { v.normalize() } else { (v / v.abs().max_element()).normalize() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::hyper;
+
+    /// The series and the closed forms agree where they meet, and with
+    /// the closed forms' own values elsewhere.
+    #[test]
+    fn hyper_matches_its_closed_forms() {
+        for u in [1e-9, 1e-5, 9.99e-4, 1.001e-3, 0.01, 0.1, 0.3, 0.4999, 0.5001, 1.0, 3.0] {
+            let (s, c, m) = hyper(u);
+            let (sh, ch) = (f64::sinh(u), f64::cosh(u));
+            let rel = |a: f64, b: f64| ((a - b) / b).abs();
+            assert!(rel(s, sh / u) < 1e-15, "{u}");
+            // (cosh − 1)/u² and (sinh − u)/u³ lose digits to cancellation in
+            // the closed form at small u; compare against extended series.
+            let c_ref =
+                if u < 0.1 { 0.5 + u * u / 24.0 + u.powi(4) / 720.0 } else { (ch - 1.0) / (u * u) };
+            let m_ref = if u < 0.1 {
+                1.0 / 6.0 + u * u / 120.0 + u.powi(4) / 5040.0
+            } else {
+                (sh - u) / u.powi(3)
+            };
+            assert!(rel(c, c_ref) < 1e-12, "{u}: {c} vs {c_ref}");
+            assert!(rel(m, m_ref) < 1e-11, "{u}: {m} vs {m_ref}");
+        }
+        assert_eq!(hyper(0.0), (1.0, 0.5, 1.0 / 6.0));
+    }
 }
