@@ -415,7 +415,6 @@ impl UnstructuredField {
 
     /// The face where the arc leaves `tet` first.
     fn leave(&self, tet: usize, arc: &Arc, exclude: Option<usize>) -> Step {
-        let t4 = self.tets[tet];
         // A bound on the time to leave (see `UnstructuredField::reach`).
         let cap = f64::from(self.reach[tet]);
         let mut faces = [Face { s0: 0.0, b: 0.0, p: 0.0 }; 4];
