@@ -26,7 +26,8 @@
 //! | `std` | yes | std float functions; implies `alloc` |
 //! | `alloc` | via `std` | gridded fields ([`Grid`], [`GridField`]) and [`skip`]ping ([`Octree`], [`trace_skipping`], [`BeamMask`]) |
 //! | `libm` | no | float functions from `libm` for `no_std` |
-//! | `io` | no | readers ([`io`]): raw + JSON header, NRRD |
+//! | `mesh` | no | unstructured meshes (`UnstructuredField`, traced exactly cell by cell; `SmoothField`, gradients recovered for an integrator); needs std |
+//! | `io` | no | readers ([`io`]): raw + JSON header, NRRD, VTK image data, VTK unstructured grids (implies `mesh`) |
 //!
 //! ## Example
 //! ```
