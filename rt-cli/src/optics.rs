@@ -405,7 +405,10 @@ impl Source for MeshVolume {
     fn pass(&self, bench: &Bench, film: &mut Film, pass: u64, seed: u64) -> anyhow::Result<()> {
         match self {
             Self::Exact(f) => Ok(bench.render_mesh(f, film, pass, seed)?),
-            Self::Smooth(s) => Ok(bench.render(s, film, pass, seed)?),
+            Self::Smooth(s) => {
+                let params = bench.params;
+                Ok(bench.render_with(&|o, d| s.trace(o, d, &params), film, pass, seed)?)
+            }
         }
     }
     fn probe(&self, bench: &Bench, film: &mut Film) -> anyhow::Result<()> {
@@ -414,13 +417,13 @@ impl Source for MeshVolume {
     fn bos(&self, bos: &Bos, seed: u64) -> anyhow::Result<BosImages> {
         match self {
             Self::Exact(f) => Ok(bos.render_mesh(f, seed)?),
-            Self::Smooth(s) => Ok(bos.render(s, seed)?),
+            Self::Smooth(s) => Ok(bos.render_with(&|o, d| s.trace(o, d, &bos.params), seed)?),
         }
     }
     fn focusing(&self, fs: &FocusingSchlieren, seed: u64) -> anyhow::Result<FocusingImages> {
         match self {
             Self::Exact(f) => Ok(fs.render_mesh(f, seed)?),
-            Self::Smooth(s) => Ok(fs.render(s, seed)?),
+            Self::Smooth(s) => Ok(fs.render_with(&|o, d| s.trace(o, d, &fs.params), seed)?),
         }
     }
 }

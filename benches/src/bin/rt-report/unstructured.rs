@@ -138,7 +138,7 @@ fn tet_smooth(c: &Case) -> Result<Built, String> {
     let cells = mesh.tetrahedra().len();
     let field = SmoothField::new(mesh);
     let params = field.params();
-    Ok(Built { cells, trace: Box::new(move |o, d| trace(&field, o, d, &params)) })
+    Ok(Built { cells, trace: Box::new(move |o, d| field.trace(o, d, &params)) })
 }
 
 /// `GridField` on the lattice, `rt_volume::trace` with
