@@ -3,17 +3,23 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use rt_photo::Cell;
 use rt_photo::{Cutoff, Mode};
 use rt_surface::io::{MeshData, read_mesh};
-use rt_volume::{Grid, io::read_grid};
+use rt_volume::{
+    Grid,
+    io::{is_unstructured, read_grid, read_unstructured},
+};
 
-use crate::optics::{Axis, Interpolation, Samples, Source, Volume};
+use crate::optics::{
+    Axis, Interpolation, MeshOptions, MeshTrace, MeshVolume, Samples, Source, Survey, Volume,
+};
 
 /// `rt info FILE`: options.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// A volume (.nrrd, .nhdr, .json, .raw, .vtk, .vti) or a mesh (.obj,
-    /// .ply, .vtk, .vtp).
+    /// A volume (.nrrd, .nhdr, .json, .raw, .vtk, .vti), an unstructured
+    /// volume mesh (.vtu, .vtk) or a surface mesh (.obj, .ply, .vtk, .vtp).
     pub file: PathBuf,
     /// What the samples are.
     #[command(flatten)]
@@ -21,6 +27,9 @@ pub struct Args {
     /// For volumes: the beam direction of the deflection survey.
     #[arg(long, value_enum, default_value_t = Axis::Z)]
     pub axis: Axis,
+    /// For unstructured meshes: the array to read.
+    #[command(flatten)]
+    pub mesh: MeshOptions,
 }
 
 /// Runs `rt info`.
@@ -29,6 +38,10 @@ pub struct Args {
 /// A file that is neither a readable volume nor a readable mesh.
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let ext = a.file.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if is_unstructured(&a.file) {
+        print!("{}", unstructured(a)?);
+        return Ok(());
+    }
     let text = match ext.as_deref() {
         Some("obj" | "ply" | "vtp") => mesh(&a.file, &read_mesh(&a.file)?),
         // Legacy VTK holds either: try image data, then polydata.
@@ -90,16 +103,69 @@ fn volume(a: &Args, g: &Grid) -> anyhow::Result<String> {
         .context("preparing the deflection survey")?;
     text += &format!("index {}\n", range(v.field.grid().data().iter().map(|&n| f64::from(n))));
     let bench = v.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
-    let survey = v.survey(&bench)?;
+    text += &survey_line(a, &v.survey(&bench)?);
+    Ok(text)
+}
+
+/// An unstructured grid: its cells by kind, the tetrahedra they split
+/// into, the boundary, the array, and the deflection survey.
+fn unstructured(a: &Args) -> anyhow::Result<String> {
+    let options = MeshOptions { mesh: MeshTrace::Exact, ..a.mesh.clone() };
+    let data = read_unstructured(&a.file, options.array.as_deref())?;
+    let mut kinds = [0usize; 4];
+    for c in &data.cells {
+        kinds[match c {
+            Cell::Tetra(_) => 0,
+            Cell::Pyramid(_) => 1,
+            Cell::Wedge(_) => 2,
+            Cell::Hexahedron(_) => 3,
+        }] += 1;
+    }
+    let coord = |k: usize| range(data.points.iter().map(move |p| p[k]));
+    let mut text = format!(
+        "{}: unstructured mesh of {} points, {} cells ({} tetrahedra, {} pyramids, {} wedges, {} hexahedra; {} lower-dimensional cells skipped)\n\
+         x {}\ny {}\nz {}\n\
+         array {} ({} data{}): {}\n",
+        a.file.display(),
+        data.points.len(),
+        data.cells.len(),
+        kinds[0],
+        kinds[1],
+        kinds[2],
+        kinds[3],
+        data.skipped_cells,
+        coord(0),
+        coord(1),
+        coord(2),
+        data.array,
+        if data.from_cells { "cell" } else { "point" },
+        if data.from_cells { ", averaged to the points" } else { "" },
+        range(data.values.iter().copied()),
+    );
+    let v = MeshVolume::new(data, a.samples.quantity, a.samples.k, true, MeshTrace::Exact)
+        .context("preparing the deflection survey")?;
+    let m = v.mesh();
     text += &format!(
+        "split into {} tetrahedra, {} boundary faces\nindex {}\n",
+        m.tetrahedra().len(),
+        m.boundary_faces(),
+        range(m.index().iter().copied()),
+    );
+    let bench = v.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
+    text += &survey_line(a, &v.survey(&bench)?);
+    Ok(text)
+}
+
+/// The survey's line of `rt info`.
+fn survey_line(a: &Args, survey: &Survey) -> String {
+    format!(
         "deflection along {} (one photon per pixel of a {}-wide survey): |ε| median {:.3e}, 99th percentile {:.3e}, max {:.3e} rad\n",
         format!("{:?}", a.axis).to_lowercase(),
         survey.width,
         survey.magnitude(0.5),
         survey.magnitude(0.99),
         survey.magnitude(1.0),
-    );
-    Ok(text)
+    )
 }
 
 fn mesh(path: &Path, m: &MeshData) -> String {

@@ -84,7 +84,7 @@ pub(crate) fn render_all(out: &Path) -> anyhow::Result<()> {
 }
 
 /// The built-in blast wave's density on every second sample, as the
-/// points and hexahedra of an unstructured mesh (33³ points, 32³ cells).
+/// points and hexahedra of an unstructured mesh (32³ points, 31³ hexahedra).
 fn blast_mesh() -> anyhow::Result<(Vec<DVec3>, Vec<Cell>, Vec<f64>)> {
     let header: serde_json::Value = serde_json::from_str(JSON).context("built-in JSON header")?;
     let grid = io::parse_raw_json(&header, RAW).context("built-in blast wave")?;
