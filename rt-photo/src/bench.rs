@@ -478,13 +478,7 @@ impl Bench {
         seed: u64,
     ) -> Result<(), BenchError> {
         let tracer = |o: DVec3, d: DVec3| {
-            let (mut sum, mut n) = (0.0, 0u32);
-            let r = trace_visiting(field, o, d, &self.params, |x| {
-                sum += scalar(x);
-                n += 1;
-            })?;
-            let c = if n > 0 { map.map((sum / f64::from(n)) as f32) } else { [1.0; 4] };
-            Ok((r, [c[0], c[1], c[2]]))
+            mean_colour(scalar, map, |visit| trace_visiting(field, o, d, &self.params, visit))
         };
         self.render_colored_with(&tracer, film, pass, seed)
     }
@@ -559,4 +553,20 @@ impl Bench {
         film.per_pixel += density;
         Ok(())
     }
+}
+
+/// The trace `trace` runs, with the colour `map(s̄)` of the mean `s̄` of
+/// `scalar` at the points it visits (white where it visits none).
+pub(crate) fn mean_colour(
+    scalar: &impl Fn(DVec3) -> f64,
+    map: &ColorMap<'_>,
+    trace: impl FnOnce(&mut dyn FnMut(DVec3)) -> Result<TraceResult, TraceError>,
+) -> Result<(TraceResult, [f32; 3]), TraceError> {
+    let (mut sum, mut n) = (0.0, 0u32);
+    let r = trace(&mut |x| {
+        sum += scalar(x);
+        n += 1;
+    })?;
+    let c = if n > 0 { map.map((sum / f64::from(n)) as f32) } else { [1.0; 4] };
+    Ok((r, [c[0], c[1], c[2]]))
 }

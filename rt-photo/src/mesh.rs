@@ -45,13 +45,7 @@ impl Bench {
         seed: u64,
     ) -> Result<(), BenchError> {
         let tracer = |o: DVec3, d: DVec3| {
-            let (mut sum, mut n) = (0.0, 0u32);
-            let r = field.trace_visiting(o, d, |x| {
-                sum += scalar(x);
-                n += 1;
-            })?;
-            let c = if n > 0 { map.map((sum / f64::from(n)) as f32) } else { [1.0; 4] };
-            Ok((r, [c[0], c[1], c[2]]))
+            crate::bench::mean_colour(scalar, map, |visit| field.trace_visiting(o, d, visit))
         };
         self.render_colored_with(&tracer, film, pass, seed)
     }

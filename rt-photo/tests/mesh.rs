@@ -103,3 +103,26 @@ fn linear_field_gives_the_same_image() {
     let d = max_diff(&gi, &mi);
     assert!(d < 1e-4, "{d}");
 }
+
+/// Multifield on a mesh: photons carry the colour of a second field
+/// averaged where they leave each cell; with a scalar equal to x and a
+/// uniform index, each image column shows the colour map at that x.
+#[test]
+fn mesh_photons_carry_the_colour_of_a_second_field() {
+    let m = mesh(7, -3.0, 3.0, &|_| 1.0);
+    let map = rt_photo::ColorMap::viridis().with_range(-3.0, 3.0).unwrap();
+    let mut film = Film::new(24, 8, Filter::Box).unwrap();
+    let b = bench(rt_photo::Mode::Schlieren(rt_photo::Cutoff::None), 2);
+    b.render_mesh_colored(&m, &|x: DVec3| x.x, &map, &mut film, 0, 4).unwrap();
+    let img = film.normalized();
+    for j in 0..8 {
+        for i in 0..24 {
+            let x = (i as f64 + 0.5) / 24.0 * 6.0 - 3.0;
+            let want = map.map(x as f32);
+            let got = img[i + 24 * j];
+            for c in 0..3 {
+                assert!((got[c] - want[c]).abs() < 0.03, "pixel {i},{j}: {got:?} vs {want:?}");
+            }
+        }
+    }
+}
