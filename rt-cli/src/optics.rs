@@ -364,6 +364,61 @@ pub trait Source {
     }
 }
 
+/// A gridded [`Volume`] or a [`MeshVolume`], for callers that hold either
+/// (the Python package's volume class).
+#[derive(Debug)]
+pub enum AnyVolume {
+    /// A grid.
+    Grid(Volume),
+    /// An unstructured mesh.
+    Mesh(MeshVolume),
+}
+
+impl Source for AnyVolume {
+    fn bounds(&self) -> Bounds {
+        match self {
+            Self::Grid(v) => v.bounds(),
+            Self::Mesh(m) => m.bounds(),
+        }
+    }
+    fn n_ref(&self) -> f64 {
+        match self {
+            Self::Grid(v) => v.n_ref(),
+            Self::Mesh(m) => m.n_ref(),
+        }
+    }
+    fn params(&self) -> TraceParams {
+        match self {
+            Self::Grid(v) => v.params(),
+            Self::Mesh(m) => m.params(),
+        }
+    }
+    fn pass(&self, bench: &Bench, film: &mut Film, pass: u64, seed: u64) -> anyhow::Result<()> {
+        match self {
+            Self::Grid(v) => v.pass(bench, film, pass, seed),
+            Self::Mesh(m) => m.pass(bench, film, pass, seed),
+        }
+    }
+    fn probe(&self, bench: &Bench, film: &mut Film) -> anyhow::Result<()> {
+        match self {
+            Self::Grid(v) => v.probe(bench, film),
+            Self::Mesh(m) => m.probe(bench, film),
+        }
+    }
+    fn bos(&self, bos: &Bos, seed: u64) -> anyhow::Result<BosImages> {
+        match self {
+            Self::Grid(v) => v.bos(bos, seed),
+            Self::Mesh(m) => m.bos(bos, seed),
+        }
+    }
+    fn focusing(&self, fs: &FocusingSchlieren, seed: u64) -> anyhow::Result<FocusingImages> {
+        match self {
+            Self::Grid(v) => v.focusing(fs, seed),
+            Self::Mesh(m) => m.focusing(fs, seed),
+        }
+    }
+}
+
 impl Source for Volume {
     fn bounds(&self) -> Bounds {
         self.field.grid().bounds()

@@ -26,6 +26,7 @@ pub(crate) fn value_error(e: impl core::fmt::Display) -> PyErr {
 fn _rtvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<volume::PyVolume>()?;
     m.add_function(wrap_pyfunction!(volume::read_volume, m)?)?;
+    m.add_function(wrap_pyfunction!(volume::read_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(optics::optics, m)?)?;
     m.add_function(wrap_pyfunction!(optics::record, m)?)?;
     m.add_function(wrap_pyfunction!(optics::bos, m)?)?;

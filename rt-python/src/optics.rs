@@ -224,7 +224,7 @@ pub(crate) fn bos<'py>(
                 bos.background =
                     ImageBackground::for_camera(&bos.camera, w, h, samples, px)?.into();
             }
-            let images = bos.render_grid(&v.field, &v.tree, a.seed)?;
+            let images = v.bos(&bos, a.seed)?;
             Ok((bos, images))
         })
         .map_err(value_error)?;
@@ -274,7 +274,7 @@ pub(crate) fn focusing<'py>(
     let (fs, images) = py
         .detach(|| -> anyhow::Result<_> {
             let fs = rt_cli::focusing::prepare(v, &a)?;
-            let images = fs.render_grid(&v.field, &v.tree, a.seed)?;
+            let images = v.focusing(&fs, a.seed)?;
             Ok((fs, images))
         })
         .map_err(value_error)?;

@@ -4,20 +4,32 @@
 use std::path::PathBuf;
 
 use numpy::PyReadonlyArray3;
+use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::{exceptions::PyOSError, prelude::*};
-use rt_cli::optics::{Interpolation, Quantity, Volume};
+use rt_cli::optics::{AnyVolume, Interpolation, MeshTrace, MeshVolume, Quantity, Volume};
 use rt_volume::{
-    Grid,
+    Cell, Grid,
     glam::DVec3,
-    io::{ReadErrorKind, read_grid},
+    io::{ReadErrorKind, UnstructuredData, read_grid, read_unstructured},
 };
 
 use crate::value_error;
 
-/// A volume ready for the optical bench (the index field and its octree).
+/// A volume ready for the optical bench: a grid (the index field and its
+/// octree) or an unstructured mesh.
 #[pyclass(name = "_Volume", module = "rtvis._rtvis", frozen)]
 pub(crate) struct PyVolume {
-    pub(crate) inner: Volume,
+    pub(crate) inner: AnyVolume,
+}
+
+impl PyVolume {
+    /// The grid, or a `ValueError` for a mesh.
+    fn grid(&self) -> PyResult<&Volume> {
+        match &self.inner {
+            AnyVolume::Grid(v) => Ok(v),
+            AnyVolume::Mesh(_) => Err(value_error("an unstructured mesh has no grid")),
+        }
+    }
 }
 
 /// `quantity` and `interpolation` by name.
@@ -54,7 +66,7 @@ fn build(
 ) -> PyResult<PyVolume> {
     let (q, i) = options(quantity, interpolation)?;
     let inner = py.detach(|| Volume::new(grid, q, k, allow_nonphysical, i)).map_err(value_error)?;
-    Ok(PyVolume { inner })
+    Ok(PyVolume { inner: AnyVolume::Grid(inner) })
 }
 
 #[pymethods]
@@ -83,35 +95,112 @@ impl PyVolume {
 
     /// Samples per axis, `(nz, ny, nx)` as the array's shape.
     #[getter]
-    fn shape(&self) -> (usize, usize, usize) {
-        let [nx, ny, nz] = self.inner.field.grid().dims();
-        (nz, ny, nx)
+    fn shape(&self) -> PyResult<(usize, usize, usize)> {
+        let [nx, ny, nz] = self.grid()?.field.grid().dims();
+        Ok((nz, ny, nx))
     }
 
     /// Sample spacing `(dx, dy, dz)`.
     #[getter]
-    fn spacing(&self) -> [f64; 3] {
-        self.inner.field.grid().spacing().to_array()
+    fn spacing(&self) -> PyResult<[f64; 3]> {
+        Ok(self.grid()?.field.grid().spacing().to_array())
     }
 
     /// Centre of sample `[0, 0, 0]`, `(x, y, z)`.
     #[getter]
-    fn origin(&self) -> [f64; 3] {
-        self.inner.field.grid().origin().to_array()
+    fn origin(&self) -> PyResult<[f64; 3]> {
+        Ok(self.grid()?.field.grid().origin().to_array())
     }
 
     /// `((xmin, ymin, zmin), (xmax, ymax, zmax))`: the box the samples
     /// cover.
     #[getter]
     fn bounds(&self) -> ([f64; 3], [f64; 3]) {
-        let b = self.inner.field.grid().bounds();
+        let b = rt_cli::optics::Source::bounds(&self.inner);
         (b.min.to_array(), b.max.to_array())
+    }
+
+    /// For a mesh: `(points, cells, tetrahedra, boundary faces)`.
+    #[getter]
+    fn mesh_counts(&self) -> PyResult<(usize, usize, usize, usize)> {
+        match &self.inner {
+            AnyVolume::Mesh(m) => {
+                let f = m.mesh();
+                Ok((f.points().len(), f.cell_count(), f.tetrahedra().len(), f.boundary_faces()))
+            }
+            AnyVolume::Grid(_) => Err(value_error("a grid is not an unstructured mesh")),
+        }
+    }
+
+    /// A mesh from points `(n, 3)`, the cells of each kind (`(m, 4)`
+    /// tetrahedra, `(m, 5)` pyramids, `(m, 6)` wedges, `(m, 8)`
+    /// hexahedra, VTK point order) and one value per point.
+    #[staticmethod]
+    #[pyo3(signature = (points, tetra, pyramid, wedge, hexahedron, values, quantity, k, trace, allow_nonphysical))]
+    #[allow(clippy::too_many_arguments)]
+    fn mesh(
+        py: Python<'_>,
+        points: PyReadonlyArray2<'_, f64>,
+        tetra: PyReadonlyArray2<'_, i64>,
+        pyramid: PyReadonlyArray2<'_, i64>,
+        wedge: PyReadonlyArray2<'_, i64>,
+        hexahedron: PyReadonlyArray2<'_, i64>,
+        values: PyReadonlyArray1<'_, f64>,
+        quantity: &str,
+        k: f64,
+        trace: &str,
+        allow_nonphysical: bool,
+    ) -> PyResult<Self> {
+        let p = points.as_array();
+        if p.ncols() != 3 {
+            return Err(value_error(format!("points: expected shape (n, 3), got {:?}", p.dim())));
+        }
+        let points: Vec<DVec3> =
+            p.rows().into_iter().map(|r| DVec3::new(r[0], r[1], r[2])).collect();
+        let mut cells = Vec::new();
+        for (name, arr, width) in [
+            ("tetra", &tetra, 4),
+            ("pyramid", &pyramid, 5),
+            ("wedge", &wedge, 6),
+            ("hexahedron", &hexahedron, 8),
+        ] {
+            let a = arr.as_array();
+            if a.nrows() > 0 && a.ncols() != width {
+                return Err(value_error(format!(
+                    "{name}: expected shape (m, {width}), got {:?}",
+                    a.dim()
+                )));
+            }
+            for (row, r) in a.rows().into_iter().enumerate() {
+                let mut ids = [0u32; 8];
+                for (slot, &v) in ids.iter_mut().zip(r.iter()) {
+                    *slot = u32::try_from(v).map_err(|_| {
+                        value_error(format!("{name}[{row}]: point index {v} out of range"))
+                    })?;
+                }
+                cells.push(match width {
+                    4 => Cell::Tetra([ids[0], ids[1], ids[2], ids[3]]),
+                    5 => Cell::Pyramid([ids[0], ids[1], ids[2], ids[3], ids[4]]),
+                    6 => Cell::Wedge([ids[0], ids[1], ids[2], ids[3], ids[4], ids[5]]),
+                    _ => Cell::Hexahedron(ids),
+                });
+            }
+        }
+        let data = UnstructuredData {
+            points,
+            cells,
+            values: values.as_array().to_vec(),
+            array: "values".into(),
+            from_cells: false,
+            skipped_cells: 0,
+        };
+        build_mesh(py, data, quantity, k, trace, allow_nonphysical)
     }
 
     /// The refractive index samples, `[z, y, x]`.
     fn index<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray3<f32>>> {
-        let (nz, ny, nx) = self.shape();
-        let data = self.inner.field.grid().data().to_vec();
+        let (nz, ny, nx) = self.shape()?;
+        let data = self.grid()?.field.grid().data().to_vec();
         let a = numpy::ndarray::Array3::from_shape_vec((nz, ny, nx), data).map_err(value_error)?;
         Ok(numpy::IntoPyArray::into_pyarray(a, py))
     }
@@ -139,4 +228,56 @@ pub(crate) fn read_volume(
         }
     })?;
     build(py, grid, quantity, k, interpolation, allow_nonphysical)
+}
+
+/// The mesh of `data`, built with the GIL released.
+fn build_mesh(
+    py: Python<'_>,
+    data: UnstructuredData,
+    quantity: &str,
+    k: f64,
+    trace: &str,
+    allow_nonphysical: bool,
+) -> PyResult<PyVolume> {
+    let (q, _) = options(quantity, "linear")?;
+    let how = match trace {
+        "exact" => MeshTrace::Exact,
+        "smooth" => MeshTrace::Smooth,
+        other => {
+            return Err(value_error(format!("trace: unknown `{other}` (known: exact, smooth)")));
+        }
+    };
+    if data.values.len() != data.points.len() {
+        return Err(value_error(format!(
+            "values: {} for {} points (one per point needed)",
+            data.values.len(),
+            data.points.len()
+        )));
+    }
+    let inner =
+        py.detach(|| MeshVolume::new(data, q, k, allow_nonphysical, how)).map_err(value_error)?;
+    Ok(PyVolume { inner: AnyVolume::Mesh(inner) })
+}
+
+/// Reads an unstructured mesh file (VTK `.vtu`, legacy `.vtk`).
+#[pyfunction]
+#[pyo3(name = "_read_mesh")]
+#[pyo3(signature = (path, array, quantity, k, trace, allow_nonphysical))]
+pub(crate) fn read_mesh(
+    py: Python<'_>,
+    path: PathBuf,
+    array: Option<String>,
+    quantity: &str,
+    k: f64,
+    trace: &str,
+    allow_nonphysical: bool,
+) -> PyResult<PyVolume> {
+    let data = py.detach(|| read_unstructured(&path, array.as_deref())).map_err(|e| {
+        let msg = e.to_string();
+        match e.kind() {
+            ReadErrorKind::Io(_) => PyOSError::new_err(msg),
+            _ => value_error(msg),
+        }
+    })?;
+    build_mesh(py, data, quantity, k, trace, allow_nonphysical)
 }

@@ -119,7 +119,7 @@ def test_bad_input(gaussian):
         rtvis.focusing(vol, aperture=-0.1, **kw)
     with pytest.raises(TypeError, match="unexpected keyword argument 'focal'"):
         rtvis.focusing(vol, focal=0.1, **kw)
-    with pytest.raises(TypeError, match="expected an rtvis.Volume, got ndarray"):
+    with pytest.raises(TypeError, match="expected an rtvis.Volume or rtvis.Mesh, got ndarray"):
         rtvis.focusing(np.ones((4, 4, 4)), **kw)
     with pytest.raises(ValueError, match=r"offset must be in \[0, 1\)"):
         rtvis.focusing(vol, offset=1.0, **kw)

@@ -1,7 +1,9 @@
 """rtvis: the rt ray tracers from Python, numpy in and numpy out.
 
 - Volumes and optics: ``Volume`` (a numpy array of density or refractive
-  index) or ``read_volume`` (NRRD, raw + JSON, VTK image data), then
+  index) or ``read_volume`` (NRRD, raw + JSON, VTK image data), or an
+  unstructured CFD mesh: ``Mesh`` (points, cells by kind, values) or
+  ``read_mesh`` (VTK ``.vtu``/``.vtk``), then
   ``schlieren``, ``shadowgraph``, ``interferogram`` and
   ``color_schlieren``: photons traced along curved paths through the
   field, each returning a float32 image normalised to the undisturbed
@@ -38,6 +40,7 @@ __all__ = [
     "GLADSTONE_DALE_AIR",
     "bos",
     "Camera",
+    "Mesh",
     "Scene",
     "Volume",
     "color_schlieren",
@@ -45,6 +48,7 @@ __all__ = [
     "composite_mpi",
     "focusing",
     "interferogram",
+    "read_mesh",
     "read_volume",
     "record",
     "schlieren",
@@ -245,11 +249,126 @@ def read_volume(
     return Volume._wrap(native)
 
 
+_MESH_KINDS = {"tetra": 4, "pyramid": 5, "wedge": 6, "hexahedron": 8}
+_TRACES = ("exact", "smooth")
+_SURFACE_KINDS = {"vertex", "line", "line3", "triangle", "triangle6", "quad", "quad8", "quad9", "polygon"}
+
+
+class Mesh:
+    """An unstructured CFD mesh (tetrahedra, pyramids, wedges, hexahedra)
+    with one value per point, ready for the optical bench.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 3)
+        Point coordinates.
+    cells : dict
+        Cells by kind, meshio's names and VTK's point order: ``"tetra"``
+        ``(m, 4)``, ``"pyramid"`` ``(m, 5)``, ``"wedge"`` ``(m, 6)``,
+        ``"hexahedron"`` ``(m, 8)`` integer arrays of point indices
+        (``meshio.Mesh.cells_dict`` fits: its vertices, lines, triangles
+        and quads are skipped, other kinds raise ``ValueError``).
+    values : array_like, shape (n,)
+        Density (kg/m³) or refractive index at each point.
+    quantity, k, allow_nonphysical
+        As for :class:`Volume`.
+    trace : "exact" or "smooth"
+        ``exact``: through the data's piecewise-linear interpolant, cell by
+        cell in closed form; ``smooth``: gradients recovered at the points
+        and integrated (second order per ray, no facets on coarse meshes).
+
+    Cells are split into tetrahedra (neighbours meet face to face); bad
+    meshes (NaN, zero-volume or inverted cells, indices out of range, a
+    face shared by three cells) raise ``ValueError`` naming the cell. The
+    index outside the mesh is that of its first point.
+    """
+
+    def __init__(self, points, cells, values, quantity: str = "density",
+                 k: float = GLADSTONE_DALE_AIR, trace: str = "exact",
+                 allow_nonphysical: bool = False):
+        pts = _array("points", points, 2, np.float64, last=3)
+        vals = _array("values", values, 1, np.float64)
+        if not isinstance(cells, dict):
+            raise TypeError(f"cells: expected a dict of kind → array, got {type(cells).__name__}")
+        by_kind = {}
+        for kind, arr in cells.items():
+            if kind in _SURFACE_KINDS or np.asarray(arr).size == 0:
+                continue  # no volume (meshio lists boundary patches too)
+            if kind not in _MESH_KINDS:
+                raise ValueError(f"cells: unknown kind {kind!r} (known: {', '.join(_MESH_KINDS)})")
+            by_kind[kind] = _array(f"cells[{kind!r}]", arr, 2, np.int64, last=_MESH_KINDS[kind], integer=True)
+        empty = {kind: np.zeros((0, width), np.int64) for kind, width in _MESH_KINDS.items()}
+        empty.update(by_kind)
+        self._v = _rtvis._Volume.mesh(
+            pts, empty["tetra"], empty["pyramid"], empty["wedge"], empty["hexahedron"], vals,
+            _choice("quantity", quantity, _QUANTITIES),
+            _number("k", k, positive=True),
+            _choice("trace", trace, _TRACES),
+            bool(allow_nonphysical),
+        )
+
+    @classmethod
+    def _wrap(cls, native) -> "Mesh":
+        m = cls.__new__(cls)
+        m._v = native
+        return m
+
+    @property
+    def bounds(self):
+        """``((xmin, ymin, zmin), (xmax, ymax, zmax))``: the box around the
+        points."""
+        lo, hi = self._v.bounds
+        return tuple(lo), tuple(hi)
+
+    @property
+    def counts(self) -> Tuple[int, int, int, int]:
+        """``(points, cells, tetrahedra, boundary faces)``."""
+        return tuple(self._v.mesh_counts)
+
+    def __repr__(self) -> str:
+        p, c, t, _ = self.counts
+        return f"rtvis.Mesh(points={p}, cells={c}, tetrahedra={t})"
+
+
+def read_mesh(
+    path,
+    array: Optional[str] = None,
+    quantity: str = "density",
+    k: float = GLADSTONE_DALE_AIR,
+    trace: str = "exact",
+    allow_nonphysical: bool = False,
+) -> Mesh:
+    """Reads an unstructured mesh: VTK XML ``.vtu`` or legacy ``.vtk``
+    (``UNSTRUCTURED_GRID``), tetrahedra, pyramids, wedges, hexahedra and
+    voxels (lower-dimensional cells are skipped).
+
+    ``array`` names the point- or cell-data array (default: the first
+    scalar point array, else the first scalar cell array, averaged to the
+    points); the others as for :class:`Mesh`. Raises ``OSError`` if the
+    file cannot be read and ``ValueError`` if it is malformed.
+    """
+    import os
+
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path: expected a str or path, got {type(path).__name__}")
+    if array is not None and not isinstance(array, str):
+        raise TypeError(f"array: expected a str, got {type(array).__name__}")
+    native = _rtvis._read_mesh(
+        os.fspath(path),
+        array,
+        _choice("quantity", quantity, _QUANTITIES),
+        _number("k", k, positive=True),
+        _choice("trace", trace, _TRACES),
+        bool(allow_nonphysical),
+    )
+    return Mesh._wrap(native)
+
+
 def _bench(volume, cutoff, *, angle=0.0, f=1.0, h=None, radius=None, half_range=None,
            wavelength=10.6e-6, fringe_spacing=None, film_distance=None, axis="z", size=512,
            photons=16, seed=1, estimator="sheet"):
-    if not isinstance(volume, Volume):
-        raise TypeError(f"volume: expected an rtvis.Volume, got {type(volume).__name__}")
+    if not isinstance(volume, (Volume, Mesh)):
+        raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
     return _rtvis._optics(
         volume._v,
         cutoff,
@@ -452,7 +571,7 @@ def color_schlieren(
                      photons=photons, seed=seed, deflection=deflection, dtype=dtype)
 
 
-def bos(volume: Volume, axis: str = "z", size: int = 512, focal_length: float = 0.1,
+def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_length: float = 0.1,
         f_number: float = 16.0, pixel: float = 5e-6, distance: Optional[float] = None,
         background_distance: Optional[float] = None, dot: float = 3.0, spacing: float = 4.0,
         samples: int = 2, seed: int = 1, background="random",
@@ -483,8 +602,8 @@ def bos(volume: Volume, axis: str = "z", size: int = 512, focal_length: float = 
 
     Example: ``ref, flow, disp, info = rtvis.bos(vol, background="grid")``.
     """
-    if not isinstance(volume, Volume):
-        raise TypeError(f"volume: expected an rtvis.Volume, got {type(volume).__name__}")
+    if not isinstance(volume, (Volume, Mesh)):
+        raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
     args = ["--axis", _choice("axis", axis, ("x", "y", "z")),
             "--size", str(_integer("size", size, 1, 8192)),
             "--focal-length", repr(_number("focal_length", focal_length, positive=True)),
@@ -515,7 +634,7 @@ def bos(volume: Volume, axis: str = "z", size: int = 512, focal_length: float = 
     return _rtvis._bos(volume._v, args, image, pixel_px)
 
 
-def focusing(volume: Volume, axis: str = "z", size: int = 512, focal_length: Optional[float] = None,
+def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_length: Optional[float] = None,
              aperture: Optional[float] = None, pixel: float = 5e-6, distance: Optional[float] = None,
              focus: float = 0.0, source_distance: Optional[float] = None, pitch: Optional[float] = None,
              duty: float = 0.5, angle: float = 0.0, offset: float = 0.25, bands: Optional[int] = None,
@@ -581,8 +700,8 @@ def focusing(volume: Volume, axis: str = "z", size: int = 512, focal_length: Opt
     Example: ``ref, flow, rel, info = rtvis.focusing(vol, focus=0.01,
     aperture=0.3)``.
     """
-    if not isinstance(volume, Volume):
-        raise TypeError(f"volume: expected an rtvis.Volume, got {type(volume).__name__}")
+    if not isinstance(volume, (Volume, Mesh)):
+        raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
     duty = _number("duty", duty)
     if not 0.0 < duty < 1.0:
         raise ValueError(f"duty must be in (0, 1) (got {duty})")

@@ -191,6 +191,12 @@ impl UnstructuredField {
         &self.tets
     }
 
+    /// How many input cells the mesh was built from.
+    #[must_use]
+    pub fn cell_count(&self) -> usize {
+        self.cell_of.last().map_or(0, |&c| c as usize + 1)
+    }
+
     /// The input cell each tetrahedron comes from.
     #[must_use]
     pub fn cell_of(&self, tet: usize) -> Option<usize> {
