@@ -369,9 +369,9 @@ pub trait Source {
 #[derive(Debug)]
 pub enum AnyVolume {
     /// A grid.
-    Grid(Volume),
+    Grid(Box<Volume>),
     /// An unstructured mesh.
-    Mesh(MeshVolume),
+    Mesh(Box<MeshVolume>),
 }
 
 impl Source for AnyVolume {

@@ -26,7 +26,7 @@ impl PyVolume {
     /// The grid, or a `ValueError` for a mesh.
     fn grid(&self) -> PyResult<&Volume> {
         match &self.inner {
-            AnyVolume::Grid(v) => Ok(v),
+            AnyVolume::Grid(v) => Ok(v.as_ref()),
             AnyVolume::Mesh(_) => Err(value_error("an unstructured mesh has no grid")),
         }
     }
@@ -66,7 +66,7 @@ fn build(
 ) -> PyResult<PyVolume> {
     let (q, i) = options(quantity, interpolation)?;
     let inner = py.detach(|| Volume::new(grid, q, k, allow_nonphysical, i)).map_err(value_error)?;
-    Ok(PyVolume { inner: AnyVolume::Grid(inner) })
+    Ok(PyVolume { inner: AnyVolume::Grid(Box::new(inner)) })
 }
 
 #[pymethods]
@@ -256,7 +256,7 @@ fn build_mesh(
     }
     let inner =
         py.detach(|| MeshVolume::new(data, q, k, allow_nonphysical, how)).map_err(value_error)?;
-    Ok(PyVolume { inner: AnyVolume::Mesh(inner) })
+    Ok(PyVolume { inner: AnyVolume::Mesh(Box::new(inner)) })
 }
 
 /// Reads an unstructured mesh file (VTK `.vtu`, legacy `.vtk`).
