@@ -194,3 +194,76 @@ fn vtk_structured_points() {
     assert!(read_grid(&nan).is_err());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A brick of the blast wave read on its own (`read_raw_json_box`): the
+/// same samples, bit for bit, as the same box of the whole grid, at the
+/// same positions; empty or out-of-range boxes and a payload of the wrong
+/// length are errors.
+#[test]
+fn a_box_of_a_raw_volume_is_that_box_of_the_whole() {
+    let whole = read_grid(&data("blast_sedov_64.json")).unwrap();
+    let (lo, hi) = ([3, 17, 40], [35, 20, 64]);
+    let part = rt_volume::io::read_raw_json_box(&data("blast_sedov_64.json"), lo, hi).unwrap();
+    assert_eq!(part.dims(), [32, 3, 24]);
+    assert_eq!(part.spacing(), whole.spacing());
+    assert_eq!(part.origin(), whole.origin() + whole.spacing() * DVec3::new(3.0, 17.0, 40.0));
+    let [nx, ny, _] = whole.dims();
+    for k in 0..24 {
+        for j in 0..3 {
+            for i in 0..32 {
+                let w = whole.data()[(i + 3) + nx * ((j + 17) + ny * (k + 40))];
+                assert_eq!(part.data()[i + 32 * (j + 3 * k)].to_bits(), w.to_bits());
+            }
+        }
+    }
+    let json = data("blast_sedov_64.json");
+    for (lo, hi) in [([0, 0, 0], [0, 4, 4]), ([0, 0, 60], [4, 4, 65]), ([5, 0, 0], [4, 4, 4])] {
+        assert!(matches!(
+            kind(rt_volume::io::read_raw_json_box(&json, lo, hi)),
+            ReadErrorKind::Malformed { .. }
+        ));
+    }
+    // A payload one sample short.
+    let dir = std::env::temp_dir().join(format!("rt-volume-box-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let raw = std::fs::read(data("blast_sedov_64.raw")).unwrap();
+    std::fs::write(dir.join("blast_sedov_64.raw"), &raw[..raw.len() - 4]).unwrap();
+    std::fs::copy(&json, dir.join("b.json")).unwrap();
+    let e = rt_volume::io::read_raw_json_box(&dir.join("b.json"), [0; 3], [2; 3]).unwrap_err();
+    assert!(matches!(e.kind(), ReadErrorKind::Truncated { .. }), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A brick of a volume larger than a `Grid` may hold (2³⁶ samples, a
+/// sparse 256 GiB payload the file system never writes): read in a moment,
+/// because only the brick's rows are read.
+#[test]
+fn a_box_of_a_volume_too_large_to_load_reads_only_its_rows() {
+    let dir = std::env::temp_dir().join(format!("rt-volume-huge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let n = 4096usize;
+    let payload = dir.join("huge.raw");
+    let f = std::fs::File::create(&payload).unwrap();
+    if f.set_len((n * n * n * 4) as u64).is_err() {
+        // No sparse file this large here: nothing to show.
+        std::fs::remove_dir_all(&dir).unwrap();
+        return;
+    }
+    // One sample set, at (100, 200, 300).
+    let at = ((100 + n * (200 + n * 300)) * 4) as u64;
+    std::io::Seek::seek(&mut &f, std::io::SeekFrom::Start(at)).unwrap();
+    std::io::Write::write_all(&mut &f, &2.5f32.to_le_bytes()).unwrap();
+    drop(f);
+    let json = dir.join("huge.json");
+    std::fs::write(
+        &json,
+        r#"{"dims": [4096, 4096, 4096], "dtype": "float32", "spacing": [1, 1, 1], "origin": [0, 0, 0], "file": "huge.raw"}"#,
+    )
+    .unwrap();
+    assert!(matches!(kind(read_grid(&json)), ReadErrorKind::TooLarge));
+    let brick = rt_volume::io::read_raw_json_box(&json, [96, 196, 296], [104, 204, 304]).unwrap();
+    assert_eq!(brick.dims(), [8; 3]);
+    assert_eq!(brick.data()[4 + 8 * (4 + 8 * 4)], 2.5);
+    assert_eq!(brick.data().iter().filter(|&&v| v != 0.0).count(), 1);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -22,7 +22,7 @@ use std::{fs, path::Path};
 
 pub use error::{ReadError, ReadErrorKind};
 pub use nrrd::{parse_nrrd, read_nrrd};
-pub use raw_json::{parse_raw_json, read_raw_json};
+pub use raw_json::{parse_raw_json, read_raw_json, read_raw_json_box};
 pub use unstructured::{UnstructuredData, is_unstructured, read_unstructured};
 pub use vtk::read_vtk;
 

@@ -26,6 +26,12 @@ pub fn read_raw_json(json_path: &Path) -> Result<Grid, ReadError> {
         let v: serde_json::Value =
             serde_json::from_slice(&text).map_err(|e| parse_error("JSON", e))?;
         let file = v["file"].as_str().ok_or_else(|| malformed("no `file`"))?;
+        // Too many samples is an error before the payload is read.
+        let [x, y, z] = header(&v)?.dims;
+        x.checked_mul(y)
+            .and_then(|n| n.checked_mul(z))
+            .filter(|&n| n <= Grid::MAX_SAMPLES)
+            .ok_or(ReadError::from(ReadErrorKind::TooLarge))?;
         let dir = json_path.parent().unwrap_or(Path::new("."));
         let payload = read(&dir.join(file))?;
         Ok((v, payload))
@@ -33,11 +39,16 @@ pub fn read_raw_json(json_path: &Path) -> Result<Grid, ReadError> {
     header().and_then(|(v, payload)| parse_raw_json(&v, &payload)).map_err(|e| e.in_file(json_path))
 }
 
-/// [`read_raw_json`] from a parsed header and the payload bytes.
-///
-/// # Errors
-/// [`ReadError`] naming the problem.
-pub fn parse_raw_json(v: &serde_json::Value, payload: &[u8]) -> Result<Grid, ReadError> {
+/// What a raw + JSON header says.
+struct Header {
+    dims: [usize; 3],
+    ty: SampleType,
+    little: bool,
+    spacing: DVec3,
+    origin: DVec3,
+}
+
+fn header(v: &serde_json::Value) -> Result<Header, ReadError> {
     let triple = |key: &str| -> Result<[f64; 3], ReadError> {
         let a = v[key].as_array().ok_or_else(|| malformed(format!("no `{key}` array")))?;
         let x: Vec<f64> = a.iter().filter_map(serde_json::Value::as_f64).collect();
@@ -64,13 +75,97 @@ pub fn parse_raw_json(v: &serde_json::Value, payload: &[u8]) -> Result<Grid, Rea
         other => return Err(unsupported(format!("dtype `{other}`"))),
     };
     let little = v["endian"].as_str().unwrap_or("little") == "little";
-    let spacing = DVec3::from(triple("spacing")?);
-    let origin = DVec3::from(triple("origin")?);
+    Ok(Header {
+        dims,
+        ty,
+        little,
+        spacing: DVec3::from(triple("spacing")?),
+        origin: DVec3::from(triple("origin")?),
+    })
+}
+
+/// [`read_raw_json`] from a parsed header and the payload bytes.
+///
+/// # Errors
+/// [`ReadError`] naming the problem.
+pub fn parse_raw_json(v: &serde_json::Value, payload: &[u8]) -> Result<Grid, ReadError> {
+    let h = header(v)?;
+    let dims = h.dims;
     let count = dims[0]
         .checked_mul(dims[1])
         .and_then(|x| x.checked_mul(dims[2]))
         .filter(|&x| x <= Grid::MAX_SAMPLES)
         .ok_or(ReadError::from(ReadErrorKind::TooLarge))?;
-    let data = decode(payload, ty, little, count)?;
-    Ok(Grid::new(dims, origin, spacing, data)?)
+    let data = decode(payload, h.ty, h.little, count)?;
+    Ok(Grid::new(dims, h.origin, h.spacing, data)?)
+}
+
+/// The samples `lo ≤ (i, j, k) < hi` of a raw + JSON volume, read without
+/// reading the rest of its payload: one seek and one read per row of the
+/// box (a brick of a volume larger than memory, with its ghost layers).
+/// The grid keeps the volume's spacing; its origin is sample `lo`'s centre.
+/// The payload must hold exactly the header's samples (checked by its
+/// length, not by reading it); the whole volume may exceed
+/// [`Grid::MAX_SAMPLES`], the box may not.
+///
+/// # Errors
+/// [`ReadError`] naming the problem: an empty box or one past the
+/// volume's `dims` is [`ReadErrorKind::Malformed`]; a payload of the wrong
+/// length [`ReadErrorKind::Truncated`].
+pub fn read_raw_json_box(
+    json_path: &Path,
+    lo: [usize; 3],
+    hi: [usize; 3],
+) -> Result<Grid, ReadError> {
+    let text = read(json_path)?;
+    let load = || -> Result<Grid, ReadError> {
+        let v: serde_json::Value =
+            serde_json::from_slice(&text).map_err(|e| parse_error("JSON", e))?;
+        let h = header(&v)?;
+        let file = v["file"].as_str().ok_or_else(|| malformed("no `file`"))?;
+        if (0..3).any(|a| lo[a] >= hi[a] || hi[a] > h.dims[a]) {
+            return Err(malformed(format!(
+                "box {lo:?}..{hi:?} is empty or outside the volume's dims {:?}",
+                h.dims
+            )));
+        }
+        let box_dims = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+        let count = box_dims[0]
+            .checked_mul(box_dims[1])
+            .and_then(|x| x.checked_mul(box_dims[2]))
+            .filter(|&x| x <= Grid::MAX_SAMPLES)
+            .ok_or(ReadError::from(ReadErrorKind::TooLarge))?;
+        let size = h.ty.size();
+        let total = h.dims[0]
+            .checked_mul(h.dims[1])
+            .and_then(|x| x.checked_mul(h.dims[2]))
+            .and_then(|x| x.checked_mul(size))
+            .ok_or(ReadError::from(ReadErrorKind::TooLarge))?;
+        let path = json_path.parent().unwrap_or(Path::new(".")).join(file);
+        let io = |e| ReadError::from(ReadErrorKind::Io(e)).in_file(&path);
+        let mut f = std::fs::File::open(&path).map_err(io)?;
+        let len = f.metadata().map_err(io)?.len();
+        if len != total as u64 {
+            return Err(ReadError::from(ReadErrorKind::Truncated {
+                expected: total,
+                found: usize::try_from(len).unwrap_or(usize::MAX),
+            })
+            .in_file(&path));
+        }
+        let row = box_dims[0] * size;
+        let mut bytes = alloc::vec![0u8; count * size];
+        let mut at = 0;
+        for k in lo[2]..hi[2] {
+            for j in lo[1]..hi[1] {
+                let first = (lo[0] + h.dims[0] * (j + h.dims[1] * k)) * size;
+                std::io::Seek::seek(&mut f, std::io::SeekFrom::Start(first as u64)).map_err(io)?;
+                std::io::Read::read_exact(&mut f, &mut bytes[at..at + row]).map_err(io)?;
+                at += row;
+            }
+        }
+        let data = decode(&bytes, h.ty, h.little, count)?;
+        let origin = h.origin + h.spacing * DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64);
+        Ok(Grid::new(box_dims, origin, h.spacing, data)?)
+    };
+    load().map_err(|e| e.in_file(json_path))
 }
