@@ -11,9 +11,7 @@ use rt_volume::{
     io::{is_unstructured, read_grid, read_unstructured},
 };
 
-use crate::optics::{
-    Axis, Interpolation, MeshOptions, MeshTrace, MeshVolume, Samples, Source, Survey, Volume,
-};
+use crate::optics::{Axis, Interpolation, MeshTrace, MeshVolume, Samples, Source, Survey, Volume};
 
 /// `rt info FILE`: options.
 #[derive(Debug, clap::Args)]
@@ -27,9 +25,11 @@ pub struct Args {
     /// For volumes: the beam direction of the deflection survey.
     #[arg(long, value_enum, default_value_t = Axis::Z)]
     pub axis: Axis,
-    /// For unstructured meshes: the array to read.
-    #[command(flatten)]
-    pub mesh: MeshOptions,
+    /// For unstructured meshes: the point- or cell-data array to read
+    /// (default: the first scalar point array, else the first scalar cell
+    /// array, averaged to the points).
+    #[arg(long)]
+    pub array: Option<String>,
 }
 
 /// Runs `rt info`.
@@ -110,8 +110,7 @@ fn volume(a: &Args, g: &Grid) -> anyhow::Result<String> {
 /// An unstructured grid: its cells by kind, the tetrahedra they split
 /// into, the boundary, the array, and the deflection survey.
 fn unstructured(a: &Args) -> anyhow::Result<String> {
-    let options = MeshOptions { mesh: MeshTrace::Exact, ..a.mesh.clone() };
-    let data = read_unstructured(&a.file, options.array.as_deref())?;
+    let data = read_unstructured(&a.file, a.array.as_deref())?;
     let mut kinds = [0usize; 4];
     for c in &data.cells {
         kinds[match c {
