@@ -20,6 +20,15 @@
 //!   gather to rank 0. The result equals [`serial_fold`] bit for bit, for
 //!   any rank count and image size; a failure on one rank is an `Err` on
 //!   every rank.
+//! - Rays across ranks ([`resolve_occlusion`]): shadow and
+//!   ambient-occlusion rays against geometry split between ranks by
+//!   space, each ray sent to the ranks whose regions it crosses, in
+//!   crossing order, until one blocks it; answers are bits. Its transport,
+//!   [`exchange::rounds`], moves batches of any work (occlusion queries,
+//!   photons handed between bricks) in rounds of all-to-all messages and
+//!   detects termination from flags the messages carry, without a barrier
+//!   per item; a rank that fails or stops answering is an `Err` on every
+//!   rank within the timeout.
 //!
 //! ```
 //! use core::time::Duration;
@@ -56,7 +65,9 @@ extern crate alloc;
 extern crate std;
 
 mod comm;
+pub mod exchange;
 mod fragment;
+mod occlusion;
 mod schedule;
 mod sparse;
 
@@ -70,6 +81,7 @@ pub use fragment::{Fragment, Pixel8, over, z_composite};
 /// callers initialise MPI with the same version.
 #[cfg(feature = "mpi")]
 pub use mpi;
+pub use occlusion::{OcclusionError, OcclusionStats, RAY_BYTES, resolve_occlusion};
 pub use schedule::{CompositeError, MessageProblem, Mode, Schedule, Stats, composite, serial_fold};
 pub use sparse::{DecodeError, SparseImage};
 

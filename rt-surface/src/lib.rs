@@ -74,6 +74,8 @@ pub mod render;
 pub mod scene;
 
 pub use mesh::{Mesh, MeshError};
+#[cfg(feature = "std")]
+pub use render::{AnswerCountError, AnsweredOcclusion, RecordOcclusion};
 pub use render::{
     Light, Material, MaterialError, RayCounts, RenderError, Renderer, Settings, SettingsError,
     ShadeScene, Surface,

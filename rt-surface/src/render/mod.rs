@@ -12,11 +12,15 @@
 //! transparency rays through opaque surfaces, and a ray that misses the
 //! scene's bounds is not traversed ([`RayCounts::culled`]).
 
+#[cfg(feature = "std")]
+mod deferred;
 mod material;
 mod renderer;
 mod settings;
 mod shade;
 
+#[cfg(feature = "std")]
+pub use deferred::{AnswerCountError, AnsweredOcclusion, RecordOcclusion};
 pub use material::{Material, MaterialError, ShadeScene, Surface};
 pub use renderer::{RayCounts, RenderError, Renderer, TILE};
 pub use settings::{Light, Settings, SettingsError};
