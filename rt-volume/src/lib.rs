@@ -51,6 +51,8 @@ extern crate alloc;
 extern crate std;
 
 mod analytic;
+#[cfg(feature = "alloc")]
+mod brick;
 mod field;
 #[cfg(feature = "alloc")]
 mod grid;
@@ -61,12 +63,19 @@ mod math;
 #[cfg(feature = "mesh")]
 pub mod mesh;
 #[cfg(feature = "alloc")]
+mod partition;
+mod reach;
+#[cfg(feature = "alloc")]
 pub mod skip;
+#[cfg(feature = "alloc")]
+mod stencil;
 mod trace;
 
 pub use analytic::{
     Constant, FnField, FnIndex, GaussianBump, GrinRod, LinearIndex, LinearSquared, Luneburg,
 };
+#[cfg(feature = "alloc")]
+pub use brick::{BrickError, BrickField, GridInfo, IndexBounds};
 pub use field::{Bounds, IndexField};
 #[cfg(feature = "alloc")]
 pub use grid::{Grid, GridError, GridField, Interp};
@@ -74,12 +83,16 @@ pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
 #[cfg(feature = "mesh")]
 pub use mesh::{Cell, MeshError, SmoothField, UnstructuredField};
 #[cfg(feature = "alloc")]
+pub use partition::Bricks;
+pub use reach::step_reach;
+#[cfg(feature = "alloc")]
 pub use skip::{
     BRICK, BeamMask, BeamWindow, MAX_BEAM_CELLS, OctNode, Octree, OctreeError, SmoothNode,
     build_octree, trace_beam, trace_skipping,
 };
 pub use trace::{
-    Exit, Method, TraceError, TraceParams, TraceResult, TraceStats, trace, trace_visiting,
+    Begin, Exit, Leg, Method, PathState, TraceError, TraceParams, TraceResult, TraceStats, trace,
+    trace_begin, trace_leg, trace_visiting,
 };
 
 pub use glam;

@@ -16,11 +16,14 @@
 //! continuation from the nearest point of the box, never the ambient index
 //! the ray meets only after leaving (see `Eval::n`).
 
+mod path_state;
+
 use core::fmt;
 
 use glam::DVec3;
+pub use path_state::PathState;
 
-use crate::{IndexField, math::powf};
+use crate::{Bounds, IndexField, math::powf};
 
 /// The integration scheme.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -195,6 +198,8 @@ pub enum TraceError {
         /// Where.
         at: DVec3,
     },
+    /// Words that no [`PathState`] writes ([`PathState::from_words`]).
+    InvalidState,
 }
 
 impl fmt::Display for TraceError {
@@ -203,6 +208,7 @@ impl fmt::Display for TraceError {
             Self::InvalidRay => write!(f, "ray origin/direction not finite or zero"),
             Self::InvalidParams => write!(f, "trace parameters must be finite and positive"),
             Self::BadField { at } => write!(f, "field is not finite and positive at {at}"),
+            Self::InvalidState => write!(f, "not the words of a ray's path state"),
         }
     }
 }
@@ -380,50 +386,173 @@ const ADAPTIVE_STEPS_PER_CHORD: f64 = 24.0;
 /// a [`Skip`]: the ray then moves `len` straight along `d̂ = T/|T|` (`T`
 /// keeps its direction, optical path by the trapezoid rule), and `bound`
 /// is added to [`TraceStats::skip_bound`].
+///
+/// Every tracer is this: [`trace_begin`] and one leg that owns all space
+/// (the code a distributed trace runs leg by leg).
 pub(crate) fn trace_impl<F: IndexField>(
     field: &F,
     origin: DVec3,
     direction: DVec3,
     params: &TraceParams,
-    mut skip: impl FnMut(DVec3, DVec3) -> Option<Skip>,
-    mut visit: impl FnMut(DVec3),
+    skip: impl FnMut(DVec3, DVec3) -> Option<Skip>,
+    visit: impl FnMut(DVec3),
 ) -> Result<TraceResult, TraceError> {
+    match trace_begin(field.bounds(), field.ambient(), origin, direction, params)? {
+        Begin::Missed(r) => Ok(r),
+        Begin::Inside(state) => match leg(field, state, params, |_| true, skip, visit)? {
+            Leg::Finished(r) => Ok(r),
+            Leg::Left(_) => unreachable!("a leg that owns all space never hands the ray on"),
+        },
+    }
+}
+
+/// How a trace starts ([`trace_begin`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Begin {
+    /// The ray never enters the bounds: this is its whole result.
+    Missed(TraceResult),
+    /// The ray at its entry point, for [`trace_leg`] on the rank owning it.
+    Inside(PathState),
+}
+
+/// How a leg of a trace ends ([`trace_leg`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Leg {
+    /// The trace is over: the same result [`trace`] gives.
+    Finished(TraceResult),
+    /// A step would start outside the space this leg owns: hand the state
+    /// to the owner of [`PathState::position`].
+    Left(PathState),
+}
+
+/// The first part of a distributed [`trace`]: checks the ray and the
+/// parameters and moves straight through the ambient medium to where the
+/// ray enters `bounds`, evaluating no field (any rank can do it knowing
+/// only the whole field's `bounds` and `ambient` index). The entry
+/// evaluation happens in the first [`trace_leg`], on the rank owning the
+/// entry point.
+///
+/// # Errors
+/// [`TraceError::InvalidRay`] and [`TraceError::InvalidParams`] as
+/// [`trace`].
+pub fn trace_begin(
+    bounds: Bounds,
+    ambient: f64,
+    origin: DVec3,
+    direction: DVec3,
+    params: &TraceParams,
+) -> Result<Begin, TraceError> {
     if !(origin.is_finite() && direction.is_finite()) || direction == DVec3::ZERO {
         return Err(TraceError::InvalidRay);
     }
     check_params(params)?;
     let d = unit(direction);
-    let bounds = field.bounds();
-    let ambient = field.ambient();
-    let mut ev = Eval { field, bounds, ambient, evals: 0, last: None };
-    let mut stats = TraceStats::default();
     let Some((t0, t1)) = bounds.clip(origin, d) else {
-        return Ok(TraceResult::missed(origin, d));
+        return Ok(Begin::Missed(TraceResult::missed(origin, d)));
     };
     // Straight through the ambient medium to the entry point.
     let x0 = origin + t0 * d;
-    // The first skip is asked before the first evaluation: a ray that only
-    // crosses constant regions needs none.
-    let mut first = Some(skip(x0, d));
-    let n0 = match first {
-        Some(Some(Skip { n: Some(n), .. })) => n,
-        _ => ev.n(x0)?.0,
+    // A NaN chord (bounds at infinity) caps nothing, as an infinite one.
+    let chord = t1 - t0;
+    Ok(Begin::Inside(PathState {
+        y: State { x: x0, t: d, opl: ambient * t0, s: 0.0 },
+        h: 0.0,
+        max_step: 0.0,
+        chord: if chord >= 0.0 { chord } else { f64::INFINITY },
+        stats: TraceStats::default(),
+        last: None,
+        entered: false,
+    }))
+}
+
+/// One leg of a distributed [`trace`]: integrates from `state` while the
+/// position at the start of each step is owned (`owns(x)`); as soon as a
+/// step would start outside, returns [`Leg::Left`] for the owner of that
+/// point to continue. A step started inside is completed, landing on the
+/// exit included, so its stage points and its end may lie up to one step
+/// ([`crate::step_reach`]) beyond the owned space: the field must be
+/// exact there.
+///
+/// `field` must be the whole field as far as the trace can tell: its
+/// [`IndexField::bounds`] and ambient index those of the whole field
+/// (exit detection and the continuation outside the box use them), its
+/// values the whole field's wherever this leg evaluates it (a
+/// [`BrickField`](crate::BrickField) is NaN elsewhere, which ends the
+/// trace with [`TraceError::BadField`]). `params` must be those given to
+/// [`trace_begin`], and `owns` the same partition of space on every rank
+/// (each point owned by exactly one). Then the legs' final result is bit
+/// for bit what [`trace`] returns on the whole field: both run this code.
+///
+/// # Errors
+/// As [`trace`].
+pub fn trace_leg<F: IndexField>(
+    field: &F,
+    state: PathState,
+    params: &TraceParams,
+    owns: impl Fn(DVec3) -> bool,
+) -> Result<Leg, TraceError> {
+    check_params(params)?;
+    leg(field, state, params, owns, |_, _| None, |_| {})
+}
+
+/// [`trace_leg`] with a skip oracle and a visitor (see [`trace_impl`]).
+fn leg<F: IndexField>(
+    field: &F,
+    state: PathState,
+    params: &TraceParams,
+    owns: impl Fn(DVec3) -> bool,
+    mut skip: impl FnMut(DVec3, DVec3) -> Option<Skip>,
+    mut visit: impl FnMut(DVec3),
+) -> Result<Leg, TraceError> {
+    if !owns(state.y.x) {
+        return Ok(Leg::Left(state));
+    }
+    let bounds = field.bounds();
+    let ambient = field.ambient();
+    let mut ev = Eval { field, bounds, ambient, evals: state.stats.field_evals, last: state.last };
+    let mut stats = state.stats;
+    let mut y = state.y;
+    let mut first = None;
+    let (max_step, mut h) = if state.entered {
+        (state.max_step, state.h)
+    } else {
+        // The entry point; `y.t` holds the unit direction. The first skip
+        // is asked before the first evaluation: a ray that only crosses
+        // constant regions needs none.
+        let d = y.t;
+        let offer = skip(y.x, d);
+        let n0 = match offer {
+            Some(Skip { n: Some(n), .. }) => n,
+            _ => ev.n(y.x)?.0,
+        };
+        first = Some(offer);
+        y.t = n0 * d;
+        let max_step = match params.method {
+            Method::Adaptive => {
+                // `t` advances by `ds/n`: the chord over 24, in `t` at entry.
+                let cap = state.chord / (ADAPTIVE_STEPS_PER_CHORD * n0);
+                if cap > 0.0 && cap < params.max_step { cap } else { params.max_step }
+            }
+            _ => params.max_step,
+        };
+        (max_step, params.step.min(max_step))
     };
-    let mut y = State { x: x0, t: n0 * d, opl: ambient * t0, s: 0.0 };
-    let max_step = match params.method {
-        Method::Adaptive => {
-            // `t` advances by `ds/n`: the chord over 24, in `t` at entry.
-            let cap = (t1 - t0) / (ADAPTIVE_STEPS_PER_CHORD * n0);
-            if cap > 0.0 && cap < params.max_step { cap } else { params.max_step }
-        }
-        _ => params.max_step,
-    };
-    let mut h = params.step.min(max_step);
     // Arc length inside the bounds where the trace stops.
     let limit = params.max_length;
     // The index at `y.x` where a skip knew it without evaluating.
     let mut known_here = None;
     let exit = loop {
+        if !owns(y.x) {
+            // Hand the ray on before the step: the state is whole.
+            if !(y.t.is_finite() && y.opl.is_finite()) {
+                // Overflowed (see the end): no state to hand on.
+                return Err(TraceError::BadField { at: y.x });
+            }
+            stats.field_evals = ev.evals;
+            let chord = state.chord;
+            let last = ev.last;
+            return Ok(Leg::Left(PathState { y, h, max_step, chord, stats, last, entered: true }));
+        }
         if stats.steps + stats.rejected >= params.max_steps {
             break Exit::MaxSteps;
         }
@@ -496,7 +625,13 @@ pub(crate) fn trace_impl<F: IndexField>(
         // path or momentum overflowed.
         return Err(TraceError::BadField { at: y.x });
     }
-    Ok(TraceResult { position: y.x, direction: unit(y.t), optical_path: y.opl, exit, stats })
+    Ok(Leg::Finished(TraceResult {
+        position: y.x,
+        direction: unit(y.t),
+        optical_path: y.opl,
+        exit,
+        stats,
+    }))
 }
 
 /// One step of size `h` (for `Adaptive`: one uncontrolled Dormand–Prince
@@ -551,7 +686,7 @@ fn fixed_step<F: IndexField>(
 }
 
 // Dormand–Prince 5(4) tableau (Dormand & Prince 1980).
-const A: [[f64; 6]; 6] = [
+pub(crate) const A: [[f64; 6]; 6] = [
     [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
     [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
     [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],

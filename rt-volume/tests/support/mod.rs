@@ -1,8 +1,11 @@
-//! Meshes of a box for the unstructured tests.
+//! A seeded generator, and meshes of a box for the unstructured tests
+//! (feature `mesh`).
 
 #![allow(dead_code)]
 
+#[cfg(feature = "mesh")]
 use glam::DVec3;
+#[cfg(feature = "mesh")]
 use rt_volume::Cell;
 
 /// SplitMix64: a small seeded generator for test meshes.
@@ -27,6 +30,7 @@ impl Rng {
 }
 
 /// How the cells of a box mesh are made.
+#[cfg(feature = "mesh")]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Kind {
     /// One hexahedron per grid cell.
@@ -47,6 +51,7 @@ pub(crate) enum Kind {
 /// `kind`. Interior points move by up to `jitter` of a spacing (boundary
 /// points only along their faces), and the point numbering is shuffled
 /// when `shuffle` (so quadrilaterals are cut along every kind of diagonal).
+#[cfg(feature = "mesh")]
 pub(crate) fn box_mesh(
     lo: DVec3,
     hi: DVec3,
