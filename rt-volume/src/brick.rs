@@ -226,7 +226,7 @@ pub struct BrickField {
 
 impl BrickField {
     /// The brick of `info`'s grid whose samples `lo .. lo + dims` are
-    /// `samples` (as [`crate::io::read_raw_json_box`] returns them; only
+    /// `samples` (as the `io` feature's `read_grid_box` returns them; only
     /// its dims and data are used, its origin and spacing are ignored).
     ///
     /// # Errors

@@ -17,6 +17,13 @@
 //!   step is shortened onto the event and sees the field's own values, so
 //!   every scheme keeps its order to the end. Reports the end point,
 //!   direction, optical path and [`TraceStats`].
+//! - Distributed tracing through a grid too large for one node: a
+//!   [`Bricks`] partition gives each rank a [`BrickField`] (its box of
+//!   samples plus the ghost layers [`step_reach`] sizes, interpolated in
+//!   the global grid's coordinates); [`trace_begin`] and one
+//!   [`trace_leg`] per brick visited, the [`PathState`] handed between
+//!   ranks as f64 words, give bit for bit [`trace`]'s result (it runs the
+//!   same code).
 //!
 //! All arithmetic is f64: the oracles are met to 1e-7 relative.
 //!
@@ -27,7 +34,7 @@
 //! | `alloc` | via `std` | gridded fields ([`Grid`], [`GridField`]) and [`skip`]ping ([`Octree`], [`trace_skipping`], [`BeamMask`]) |
 //! | `libm` | no | float functions from `libm` for `no_std` |
 //! | `mesh` | no | unstructured meshes (`UnstructuredField`, traced exactly cell by cell; `SmoothField`, gradients recovered for an integrator); needs std |
-//! | `io` | no | readers ([`io`]): raw + JSON header, NRRD, VTK image data, VTK unstructured grids (implies `mesh`) |
+//! | `io` | no | readers (module `io`): raw + JSON header, NRRD, VTK image data, VTK unstructured grids (implies `mesh`) |
 //!
 //! ## Example
 //! ```

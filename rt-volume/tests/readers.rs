@@ -267,3 +267,222 @@ fn a_box_of_a_volume_too_large_to_load_reads_only_its_rows() {
     assert_eq!(brick.data().iter().filter(|&&v| v != 0.0).count(), 1);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The box `lo..hi` of a whole grid, as the box readers return it.
+fn cut(whole: &rt_volume::Grid, lo: [usize; 3], hi: [usize; 3]) -> rt_volume::Grid {
+    let [nx, ny, _] = whole.dims();
+    let mut data = Vec::new();
+    for k in lo[2]..hi[2] {
+        for j in lo[1]..hi[1] {
+            let row = nx * (j + ny * k);
+            data.extend_from_slice(&whole.data()[row + lo[0]..row + hi[0]]);
+        }
+    }
+    let origin =
+        whole.origin() + whole.spacing() * DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64);
+    let dims = [0, 1, 2].map(|a| hi[a] - lo[a]);
+    rt_volume::Grid::new(dims, origin, whole.spacing(), data).unwrap()
+}
+
+fn bit_equal(a: &rt_volume::Grid, b: &rt_volume::Grid) {
+    assert_eq!((a.dims(), a.origin(), a.spacing()), (b.dims(), b.origin(), b.spacing()));
+    let bits = |g: &rt_volume::Grid| g.data().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(a), bits(b));
+}
+
+/// A scratch directory, removed when dropped.
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("rt-volume-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        Self(dir)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        std::fs::remove_dir_all(&self.0).ok();
+    }
+}
+
+/// A box of a NRRD volume (raw encoding; detached and attached data;
+/// both byte orders; float, double and 16-bit samples) is that box of the
+/// whole file's grid, bit for bit; its header alone gives the grid's
+/// geometry; the dispatching readers pick NRRD and raw + JSON by
+/// extension.
+#[test]
+fn a_box_of_a_nrrd_volume_is_that_box_of_the_whole() {
+    use rt_volume::io::{read_grid_box, read_grid_info, read_nrrd_box};
+    let dir = Scratch::new("nrrd-box");
+    let dims = [7usize, 5, 6];
+    let count = dims.iter().product::<usize>();
+    let values: Vec<f64> =
+        (0..count).map(|i| 1.0 + (i as f64 * 0.37).sin().abs() * 300.0).collect();
+    let boxes = [
+        ([0, 0, 0], [7, 5, 6]),
+        ([2, 1, 3], [5, 4, 6]),
+        ([6, 4, 5], [7, 5, 6]),
+        ([0, 2, 0], [7, 3, 2]),
+    ];
+    for (ty, size) in [("float", 4), ("double", 8), ("ushort", 2)] {
+        for endian in ["little", "big"] {
+            let mut payload = Vec::new();
+            for &v in &values {
+                let bytes: Vec<u8> = match (ty, endian) {
+                    ("float", "little") => (v as f32).to_le_bytes().to_vec(),
+                    ("float", _) => (v as f32).to_be_bytes().to_vec(),
+                    ("double", "little") => v.to_le_bytes().to_vec(),
+                    ("double", _) => v.to_be_bytes().to_vec(),
+                    (_, "little") => (v as u16).to_le_bytes().to_vec(),
+                    _ => (v as u16).to_be_bytes().to_vec(),
+                };
+                payload.extend(bytes);
+            }
+            assert_eq!(payload.len(), count * size);
+            let fields = format!(
+                "NRRD0004\ntype: {ty}\ndimension: 3\nsizes: 7 5 6\nspacings: 0.5 0.25 2\n\
+                 space origin: (1, -2, 0.5)\nendian: {endian}\nencoding: raw\n"
+            );
+            let name = format!("{ty}-{endian}");
+            let raw = dir.0.join(format!("{name}.raw"));
+            std::fs::write(&raw, &payload).unwrap();
+            let nhdr = dir.0.join(format!("{name}.nhdr"));
+            std::fs::write(&nhdr, format!("{fields}data file: {name}.raw\n\n")).unwrap();
+            let nrrd = dir.0.join(format!("{name}.nrrd"));
+            let mut attached = format!("{fields}\n").into_bytes();
+            attached.extend(&payload);
+            std::fs::write(&nrrd, attached).unwrap();
+            for path in [&nhdr, &nrrd] {
+                let whole = read_grid(path).unwrap();
+                assert_eq!(whole.dims(), dims);
+                assert_eq!(whole.origin(), DVec3::new(1.0, -2.0, 0.5));
+                assert_eq!(read_grid_info(path).unwrap(), whole.info());
+                for (lo, hi) in boxes {
+                    let part = read_nrrd_box(path, lo, hi).unwrap();
+                    bit_equal(&part, &cut(&whole, lo, hi));
+                    bit_equal(&read_grid_box(path, lo, hi).unwrap(), &part);
+                }
+            }
+        }
+    }
+    // The project's data: its detached header, and raw + JSON.
+    let whole = read_grid(&data("blast_sedov_64.nhdr")).unwrap();
+    let (lo, hi) = ([3, 17, 40], [35, 20, 64]);
+    bit_equal(&read_nrrd_box(&data("blast_sedov_64.nhdr"), lo, hi).unwrap(), &cut(&whole, lo, hi));
+    for name in ["blast_sedov_64.nhdr", "blast_sedov_64.json", "blast_sedov_64.raw"] {
+        assert_eq!(read_grid_info(&data(name)).unwrap(), whole.info(), "{name}");
+        bit_equal(&read_grid_box(&data(name), lo, hi).unwrap(), &cut(&whole, lo, hi));
+    }
+}
+
+/// Boxes that do not fit, payloads of the wrong length, compressed
+/// encodings, missing files and formats without a header of their own are
+/// errors naming the problem.
+#[test]
+fn bad_nrrd_boxes_and_headers_are_errors() {
+    use rt_volume::io::{read_grid_box, read_grid_info, read_nrrd_box, read_nrrd_info};
+    let dir = Scratch::new("nrrd-bad");
+    let fields = "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nencoding: raw\n";
+    let payload = vec![0x3f_u8; 2 * 3 * 4 * 4];
+    let write = |name: &str, bytes: &[u8]| {
+        let p = dir.0.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p
+    };
+    let attached = |extra: &[u8]| {
+        let mut v = format!("{fields}\n").into_bytes();
+        v.extend(extra);
+        v
+    };
+    let ok = write("ok.nrrd", &attached(&payload));
+    assert!(read_nrrd_box(&ok, [0; 3], [2, 3, 4]).is_ok());
+    for (lo, hi) in [
+        ([0, 0, 0], [0, 3, 4]),
+        ([0, 0, 0], [2, 3, 5]),
+        ([1, 0, 0], [1, 1, 1]),
+        ([3, 0, 0], [2, 3, 4]),
+    ] {
+        let e = read_nrrd_box(&ok, lo, hi).unwrap_err();
+        assert!(matches!(e.kind(), ReadErrorKind::Malformed { .. }), "{lo:?}..{hi:?}: {e}");
+    }
+    // One byte short, one too many: attached and detached.
+    let short = write("short.nrrd", &attached(&payload[1..]));
+    let long = write("long.nrrd", &attached(&[&payload[..], &[0]].concat()));
+    write("short.raw", &payload[1..]);
+    let detached = write("short.nhdr", format!("{fields}data file: short.raw\n\n").as_bytes());
+    for p in [&short, &long, &detached] {
+        let e = read_nrrd_box(p, [0; 3], [1; 3]).unwrap_err();
+        assert!(matches!(e.kind(), ReadErrorKind::Truncated { expected: 96, .. }), "{e}");
+    }
+    // Compressed: refused, saying why.
+    let gz = write("gz.nrrd", &attached(&payload).replace_encoding());
+    let e = read_nrrd_box(&gz, [0; 3], [1; 3]).unwrap_err();
+    assert!(matches!(e.kind(), ReadErrorKind::Unsupported(m) if m.contains("raw")), "{e}");
+    // A detached file that is not there; a header without its blank line;
+    // not NRRD at all.
+    let gone = write("gone.nhdr", format!("{fields}data file: nowhere.raw\n\n").as_bytes());
+    assert!(matches!(
+        read_nrrd_box(&gone, [0; 3], [1; 3]).unwrap_err().kind(),
+        ReadErrorKind::Io(_)
+    ));
+    assert!(read_nrrd_info(&gone).is_ok(), "the header alone reads no payload");
+    let open = write("open.nrrd", fields.as_bytes());
+    assert!(matches!(read_nrrd_info(&open).unwrap_err().kind(), ReadErrorKind::Malformed { .. }));
+    let not = write("not.nrrd", b"P6\n\n");
+    assert!(matches!(read_nrrd_info(&not).unwrap_err().kind(), ReadErrorKind::Malformed { .. }));
+    let zero =
+        write("zero.nhdr", b"NRRD0004\ntype: float\ndimension: 3\nsizes: 2 0 2\nencoding: raw\n\n");
+    assert!(matches!(read_nrrd_info(&zero).unwrap_err().kind(), ReadErrorKind::Grid(_)));
+    // Formats and extensions without a header reader.
+    let vti = write("x.vti", b"<VTKFile/>");
+    assert!(matches!(read_grid_info(&vti).unwrap_err().kind(), ReadErrorKind::Unsupported(_)));
+    assert!(matches!(
+        read_grid_box(&vti, [0; 3], [1; 3]).unwrap_err().kind(),
+        ReadErrorKind::Unsupported(_)
+    ));
+    let txt = write("x.txt", b"");
+    assert!(matches!(read_grid_info(&txt).unwrap_err().kind(), ReadErrorKind::UnknownFormat));
+    let e = read_grid_info(Path::new("/nonexistent/x.json")).unwrap_err();
+    assert!(matches!(e.kind(), ReadErrorKind::Io(_)) && e.path().is_some(), "{e}");
+}
+
+/// `encoding: raw` → `encoding: gzip` in a header's bytes.
+trait ReplaceEncoding {
+    fn replace_encoding(self) -> Vec<u8>;
+}
+
+impl ReplaceEncoding for Vec<u8> {
+    fn replace_encoding(self) -> Vec<u8> {
+        let at = self.windows(13).position(|w| w == b"encoding: raw").unwrap();
+        [&self[..at], b"encoding: gzip", &self[at + 13..]].concat()
+    }
+}
+
+/// A brick of an attached NRRD volume of 2³⁶ samples (a sparse 256 GiB
+/// file): its header and rows only are read.
+#[test]
+fn a_box_of_a_huge_attached_nrrd_reads_only_its_rows() {
+    let dir = Scratch::new("nrrd-huge");
+    let n = 4096usize;
+    let header = b"NRRD0005\ntype: float\ndimension: 3\nsizes: 4096 4096 4096\nendian: little\nencoding: raw\n\n";
+    let path = dir.0.join("huge.nrrd");
+    let f = std::fs::File::create(&path).unwrap();
+    if f.set_len((header.len() + n * n * n * 4) as u64).is_err() {
+        // No sparse file this large here: nothing to show.
+        return;
+    }
+    std::io::Write::write_all(&mut &f, header).unwrap();
+    let at = (header.len() + (100 + n * (200 + n * 300)) * 4) as u64;
+    std::io::Seek::seek(&mut &f, std::io::SeekFrom::Start(at)).unwrap();
+    std::io::Write::write_all(&mut &f, &2.5f32.to_le_bytes()).unwrap();
+    drop(f);
+    let info = rt_volume::io::read_grid_info(&path).unwrap();
+    assert_eq!(info.dims, [4096; 3]);
+    assert!(matches!(kind(read_grid(&path)), ReadErrorKind::TooLarge));
+    let brick = rt_volume::io::read_nrrd_box(&path, [96, 196, 296], [104, 204, 304]).unwrap();
+    assert_eq!(brick.dims(), [8; 3]);
+    assert_eq!(brick.data()[4 + 8 * (4 + 8 * 4)], 2.5);
+    assert_eq!(brick.data().iter().filter(|&&v| v != 0.0).count(), 1);
+}

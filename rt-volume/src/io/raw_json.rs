@@ -10,8 +10,9 @@ use super::{
     decode::{SampleType, decode},
     error::{malformed, parse_error, unsupported},
     read,
+    sub_box::{Payload, read_box},
 };
-use crate::Grid;
+use crate::{Grid, GridInfo};
 
 /// Reads raw samples described by a JSON header such as the project's
 /// sidecar: `dims` `[nx, ny, nz]`, `dtype` (`float32`, `float64`, `uint8`,
@@ -123,49 +124,34 @@ pub fn read_raw_json_box(
             serde_json::from_slice(&text).map_err(|e| parse_error("JSON", e))?;
         let h = header(&v)?;
         let file = v["file"].as_str().ok_or_else(|| malformed("no `file`"))?;
-        if (0..3).any(|a| lo[a] >= hi[a] || hi[a] > h.dims[a]) {
-            return Err(malformed(format!(
-                "box {lo:?}..{hi:?} is empty or outside the volume's dims {:?}",
-                h.dims
-            )));
-        }
-        let box_dims = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
-        let count = box_dims[0]
-            .checked_mul(box_dims[1])
-            .and_then(|x| x.checked_mul(box_dims[2]))
-            .filter(|&x| x <= Grid::MAX_SAMPLES)
-            .ok_or(ReadError::from(ReadErrorKind::TooLarge))?;
-        let size = h.ty.size();
-        let total = h.dims[0]
-            .checked_mul(h.dims[1])
-            .and_then(|x| x.checked_mul(h.dims[2]))
-            .and_then(|x| x.checked_mul(size))
-            .ok_or(ReadError::from(ReadErrorKind::TooLarge))?;
         let path = json_path.parent().unwrap_or(Path::new(".")).join(file);
-        let io = |e| ReadError::from(ReadErrorKind::Io(e)).in_file(&path);
-        let mut f = std::fs::File::open(&path).map_err(io)?;
-        let len = f.metadata().map_err(io)?.len();
-        if len != total as u64 {
-            return Err(ReadError::from(ReadErrorKind::Truncated {
-                expected: total,
-                found: usize::try_from(len).unwrap_or(usize::MAX),
-            })
-            .in_file(&path));
-        }
-        let row = box_dims[0] * size;
-        let mut bytes = alloc::vec![0u8; count * size];
-        let mut at = 0;
-        for k in lo[2]..hi[2] {
-            for j in lo[1]..hi[1] {
-                let first = (lo[0] + h.dims[0] * (j + h.dims[1] * k)) * size;
-                std::io::Seek::seek(&mut f, std::io::SeekFrom::Start(first as u64)).map_err(io)?;
-                std::io::Read::read_exact(&mut f, &mut bytes[at..at + row]).map_err(io)?;
-                at += row;
-            }
-        }
-        let data = decode(&bytes, h.ty, h.little, count)?;
-        let origin = h.origin + h.spacing * DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64);
-        Ok(Grid::new(box_dims, origin, h.spacing, data)?)
+        let payload = Payload {
+            path: &path,
+            offset: 0,
+            dims: h.dims,
+            ty: h.ty,
+            little: h.little,
+            origin: h.origin,
+            spacing: h.spacing,
+        };
+        read_box(&payload, lo, hi)
+    };
+    load().map_err(|e| e.in_file(json_path))
+}
+
+/// The header of a raw + JSON volume (dims, origin, spacing), without
+/// reading its payload.
+///
+/// # Errors
+/// [`ReadError`] naming the problem; a header [`GridInfo::new`] refuses
+/// is [`ReadErrorKind::Grid`].
+pub fn read_raw_json_info(json_path: &Path) -> Result<GridInfo, ReadError> {
+    let text = read(json_path)?;
+    let load = || -> Result<GridInfo, ReadError> {
+        let v: serde_json::Value =
+            serde_json::from_slice(&text).map_err(|e| parse_error("JSON", e))?;
+        let h = header(&v)?;
+        Ok(GridInfo::new(h.dims, h.origin, h.spacing)?)
     };
     load().map_err(|e| e.in_file(json_path))
 }
