@@ -255,6 +255,38 @@ impl MeshVolume {
     }
 }
 
+/// A bench looking through the box `b` along `axis` (what
+/// [`Source::bench`] builds): the beam covers the box's cross-section and
+/// starts upstream of it; the optics image the box's mid-plane, the film
+/// sits `film_distance` behind it (negative: in front).
+#[must_use]
+pub fn bench_through(
+    b: Bounds,
+    axis: Axis,
+    mode: Mode,
+    film_distance: f64,
+    params: TraceParams,
+) -> Bench {
+    let (direction, u) = axis.frame();
+    let v = direction.cross(u);
+    let ext = b.max - b.min;
+    let upstream = 0.5 * ext.dot(direction) + 0.1 * ext.length();
+    Bench {
+        center: 0.5 * (b.min + b.max) - upstream * direction,
+        image_plane: upstream,
+        direction,
+        u,
+        width: ext.dot(u),
+        height: ext.dot(v),
+        film_distance,
+        mode,
+        weighting: Weighting::Weight,
+        reconstruction: Reconstruction::Sheet,
+        strata: 1,
+        params,
+    }
+}
+
 /// What the bench looks through: a gridded [`Volume`] or a [`MeshVolume`].
 pub trait Source {
     /// The box the field fills.
@@ -290,25 +322,7 @@ pub trait Source {
     /// it (negative: in front). Mode and film distance are the caller's.
     #[must_use]
     fn bench(&self, axis: Axis, mode: Mode, film_distance: f64) -> Bench {
-        let b = self.bounds();
-        let (direction, u) = axis.frame();
-        let v = direction.cross(u);
-        let ext = b.max - b.min;
-        let upstream = 0.5 * ext.dot(direction) + 0.1 * ext.length();
-        Bench {
-            center: 0.5 * (b.min + b.max) - upstream * direction,
-            image_plane: upstream,
-            direction,
-            u,
-            width: ext.dot(u),
-            height: ext.dot(v),
-            film_distance,
-            mode,
-            weighting: Weighting::Weight,
-            reconstruction: Reconstruction::Sheet,
-            strata: 1,
-            params: self.params(),
-        }
+        bench_through(self.bounds(), axis, mode, film_distance, self.params())
     }
 
     /// Renders `photons` photons per pixel (rounded up to whole passes of

@@ -93,6 +93,12 @@ pub(crate) fn positive(s: &str) -> Result<f64, String> {
     if v > 0.0 { Ok(v) } else { Err(format!("{v}: must be > 0")) }
 }
 
+/// A finite number `≥ 0`.
+pub(crate) fn non_negative(s: &str) -> Result<f64, String> {
+    let v = finite(s)?;
+    if v >= 0.0 { Ok(v) } else { Err(format!("{v}: must be ≥ 0")) }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

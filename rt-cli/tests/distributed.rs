@@ -4,7 +4,10 @@
 
 use core::time::Duration;
 
-use rt_cli::distributed::surface::{self, SurfaceJob};
+use rt_cli::distributed::{
+    surface::{self, SurfaceJob},
+    volume,
+};
 use rt_composite::{Schedule, ThreadComm};
 use rt_core::{Frame, Pixel};
 
@@ -64,4 +67,70 @@ fn surfaces_with_shadows_and_ao_equal_one_process_bit_for_bit() {
         let triangles: usize = reports.iter().map(|r| r.triangles).sum();
         assert_eq!(triangles, 2 * 64 * 64, "{ranks} ranks own every triangle once");
     }
+}
+
+/// Rank 0's film and every rank's report for a volume job.
+fn volumes(job: &volume::VolumeJob, ranks: usize) -> (rt_photo::Film, Vec<volume::VolumeRank>) {
+    let comms = ThreadComm::group(ranks, Duration::from_secs(60));
+    let out: Vec<_> = std::thread::scope(|s| {
+        let handles: Vec<_> =
+            comms.into_iter().map(|c| s.spawn(move || volume::rank(&c, job))).collect();
+        handles.into_iter().map(|h| h.join().expect("rank panicked")).collect()
+    });
+    let mut film = None;
+    let mut reports = Vec::new();
+    for (r, o) in out.into_iter().enumerate() {
+        let (f, rep) = o.unwrap_or_else(|e| panic!("{ranks} ranks, rank {r}: {e:#}"));
+        assert_eq!(f.is_some(), r == 0);
+        film = film.or(f);
+        reports.push(rep);
+    }
+    (film.expect("rank 0's film"), reports)
+}
+
+/// Knife-edge schlieren and interferometry of the blast wave, photons
+/// handed between bricks that each rank read alone from the file: the film
+/// equals one process tracing the whole grid, bit for bit, and no rank
+/// held the whole grid.
+#[test]
+fn volumes_equal_one_process_bit_for_bit_and_no_rank_holds_the_grid() {
+    let dir = std::env::temp_dir().join(format!("rt-cli-test-distributed-{}", std::process::id()));
+    let knife = volume::VolumeJob::builtin(&dir, 40, 1).unwrap();
+    let fringes = volume::VolumeJob {
+        optics: volume::VolumeOptics::Interferometry { lambda: 10.6e-6, fringes: Some(0.04) },
+        interp: rt_volume::Interp::Trilinear,
+        ..knife.clone()
+    };
+    for job in [&knife, &fringes] {
+        let whole = volume::single(job).unwrap();
+        for ranks in [1usize, 2, 3, 4, 7, 16] {
+            let (film, reports) = volumes(job, ranks);
+            assert!(
+                volume::same(&film, &whole),
+                "{ranks} ranks, {:?}: the films differ",
+                job.optics
+            );
+            let entered: u64 = reports.iter().map(|r| r.entered).sum();
+            let handed: u64 = reports.iter().map(|r| r.handed_off).sum();
+            let legs: u64 = reports.iter().map(|r| r.legs).sum();
+            // Every leg but a photon's last ends in a hand-off.
+            assert_eq!(legs, entered + handed, "{ranks} ranks");
+            for r in &reports {
+                if ranks > 1 {
+                    assert!(
+                        r.brick_samples < r.grid_samples,
+                        "{ranks} ranks: a rank held the grid"
+                    );
+                } else {
+                    assert_eq!(r.brick_samples, r.grid_samples);
+                }
+            }
+            // Bricks split the beam's axis from 2 ranks up (for 2: 2×1×1 along
+            // the longest axis, a cube's first: x; so from 3 check travel).
+            if ranks >= 4 {
+                assert!(handed > 0, "{ranks} ranks: no photon crossed a brick");
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -35,7 +35,7 @@
 //!   rendered from it as `rt schlieren blast.vtu --mesh smooth` does.
 mod optics;
 
-pub use optics::{blast_wave, blast_wave_with};
+pub use optics::{blast_wave, blast_wave_with, write_blast_wave};
 
 use std::{path::PathBuf, time::Instant};
 

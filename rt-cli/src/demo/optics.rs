@@ -38,6 +38,20 @@ pub fn blast_wave_with(interp: Interpolation) -> anyhow::Result<Volume> {
     Volume::density(grid, interp)
 }
 
+/// Writes the built-in blast wave into `dir` as raw + JSON (for tools
+/// that read a file a brick at a time); returns the JSON's path.
+///
+/// # Errors
+/// `dir` cannot be created or written.
+pub fn write_blast_wave(dir: &Path) -> anyhow::Result<std::path::PathBuf> {
+    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    let json = dir.join("blast_sedov_64.json");
+    std::fs::write(&json, JSON).with_context(|| json.display().to_string())?;
+    let raw = dir.join("blast_sedov_64.raw");
+    std::fs::write(&raw, RAW).with_context(|| raw.display().to_string())?;
+    Ok(json)
+}
+
 /// Renders the four optical pictures into `out`.
 pub(crate) fn render_all(out: &Path) -> anyhow::Result<()> {
     let volume = blast_wave()?;

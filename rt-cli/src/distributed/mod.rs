@@ -7,6 +7,8 @@
 //! # ranks as MPI processes (Debian: libopenmpi-dev openmpi-bin libclang-dev)
 //! cargo build --release -p rt-cli --features mpi
 //! mpirun -np 4 target/release/rt distributed --shadows --ao 4 --schedule radix-3
+//! # knife-edge schlieren of a volume, photons handed between bricks
+//! rt distributed --ranks 8 --volume blast.json
 //! ```
 //!
 //! **Surfaces** (the default): the terrain is cut into slabs of triangles
@@ -15,19 +17,34 @@
 //! answered by every rank whose region they cross (see [`surface`]), and
 //! the frames are z-composited.
 //!
+//! **Volumes** (`--volume [FILE]`): the grid is split into bricks, one per
+//! rank; each rank reads only its brick and its ghost layers from the
+//! file, and photons are handed from brick to brick (see [`volume`]);
+//! rank 0 lands them on the film in the bench's fixed order.
+//!
 //! The image is written by rank 0, which also renders the whole mesh in
 //! one process and compares: the program exits non-zero if one bit of
 //! depth or colour differs.
 
 pub mod surface;
+pub mod volume;
 
-use std::{path::PathBuf, time::Instant};
+use std::{
+    path::{Path, PathBuf},
+    time::Instant,
+};
 
 use anyhow::{anyhow, bail};
+use clap::ValueEnum;
 use rt_composite::{Communicator, Schedule};
 use rt_core::{Frame, Pixel};
+use rt_photo::Film;
 
-use crate::{image::write_png, parse};
+use crate::{
+    image::{film_frame, write_png},
+    optics::{Interpolation, Samples},
+    parse,
+};
 
 /// A compositing schedule: `direct-send`, `binary-swap` or `radix-K`.
 fn schedule(s: &str) -> Result<Schedule, String> {
@@ -79,12 +96,87 @@ pub struct Args {
     /// Compositing schedule: direct-send, binary-swap or radix-K (K ≥ 2).
     #[arg(long, value_parser = schedule, default_value = "binary-swap")]
     pub schedule: Schedule,
-    /// PNG rank 0 writes.
-    #[arg(long, default_value = "out/distributed.png")]
-    pub out: PathBuf,
+    /// Render a volume instead of the terrain: knife-edge schlieren (or
+    /// `--record interferometry`) with photons handed between bricks. FILE
+    /// is a raw + JSON volume or an NRRD volume with raw encoding; without
+    /// FILE, the built-in blast wave.
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "built-in")]
+    pub volume: Option<PathBuf>,
+    /// Volume: what the film records.
+    #[arg(long, value_enum, default_value_t = Record::Knife)]
+    pub record: Record,
+    /// Volume: photons per pixel are STRATA² (the film is WIDTH of
+    /// `--size` wide, its height from the volume's aspect).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
+    pub strata: u32,
+    /// Volume: interpolation between samples.
+    #[arg(long, value_enum, default_value_t = Interpolation::Cubic)]
+    pub interp: Interpolation,
+    /// Volume, interferometry: wavelength in metres.
+    #[arg(long, default_value_t = 10.6e-6, value_parser = parse::positive)]
+    pub lambda: f64,
+    /// Volume, interferometry: carrier fringe spacing in metres (0:
+    /// infinite fringe).
+    #[arg(long, default_value_t = 0.04, value_parser = parse::non_negative)]
+    pub fringes: f64,
+    /// Volume: what the samples are.
+    #[command(flatten)]
+    pub samples: Samples,
+    /// PNG rank 0 writes [default: out/distributed.png, with --volume
+    /// out/distributed-volume.png].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// What a distributed volume render records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Record {
+    /// Knife-edge schlieren.
+    Knife,
+    /// Interferometry.
+    Interferometry,
 }
 
 impl Args {
+    fn out(&self) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| {
+            PathBuf::from(if self.volume.is_some() {
+                "out/distributed-volume.png"
+            } else {
+                "out/distributed.png"
+            })
+        })
+    }
+
+    /// The volume job, its built-in data written under `scratch` when no
+    /// file is given.
+    fn volume_job(&self, file: &Path, scratch: &Path) -> anyhow::Result<volume::VolumeJob> {
+        let file = if file == Path::new("built-in") {
+            volume::builtin_file(scratch)?
+        } else {
+            file.to_path_buf()
+        };
+        Ok(volume::VolumeJob {
+            file,
+            quantity: self.samples.quantity,
+            k: self.samples.k,
+            interp: match self.interp {
+                Interpolation::Linear => rt_volume::Interp::Trilinear,
+                Interpolation::Cubic => rt_volume::Interp::CatmullRom,
+            },
+            optics: match self.record {
+                Record::Knife => volume::VolumeOptics::Knife,
+                Record::Interferometry => volume::VolumeOptics::Interferometry {
+                    lambda: self.lambda,
+                    fringes: (self.fringes > 0.0).then_some(self.fringes),
+                },
+            },
+            size: self.size.0,
+            strata: self.strata,
+            seed: self.seed,
+        })
+    }
+
     fn surface_job(&self) -> surface::SurfaceJob {
         surface::SurfaceJob {
             size: self.size,
@@ -98,10 +190,40 @@ impl Args {
     }
 }
 
+/// Where rank `rank` writes the built-in volume (removed by `run`).
+fn scratch(rank: usize) -> PathBuf {
+    std::env::temp_dir().join(format!("rt-distributed-{}-{rank}", std::process::id()))
+}
+
+/// What rank 0 has at the end.
+enum Image {
+    Surface(Frame),
+    Volume(Film, volume::VolumeJob),
+}
+
 /// What one rank does; rank 0 returns the image.
-fn rank_main<C: Communicator>(comm: &C, o: &Args) -> anyhow::Result<Option<Frame>> {
+fn rank_main<C: Communicator>(comm: &C, o: &Args) -> anyhow::Result<Option<Image>> {
     let (rank, ranks) = (comm.rank(), comm.size());
     let t = Instant::now();
+    if let Some(file) = &o.volume {
+        let job = o.volume_job(file, &scratch(rank))?;
+        let (film, r) = volume::rank(comm, &job)?;
+        println!(
+            "rank {rank}/{ranks}: brick of {} samples ({:.1} % of the grid's {}), {} photons entered here, \
+             {} legs traced, {} handed to other ranks, {} rounds, {} bytes in {} messages; {:.3} s",
+            r.brick_samples,
+            100.0 * r.brick_samples as f64 / r.grid_samples as f64,
+            r.grid_samples,
+            r.entered,
+            r.legs,
+            r.handed_off,
+            r.exchange.rounds,
+            r.exchange.bytes_sent,
+            r.exchange.messages,
+            t.elapsed().as_secs_f64(),
+        );
+        return Ok(film.map(|f| Image::Volume(f, job)));
+    }
     let (image, r) = surface::rank(comm, &o.surface_job())?;
     let occ = &r.occlusion;
     println!(
@@ -122,22 +244,48 @@ fn rank_main<C: Communicator>(comm: &C, o: &Args) -> anyhow::Result<Option<Frame
         r.composite.messages,
         t.elapsed().as_secs_f64(),
     );
-    Ok(image)
+    Ok(image.map(Image::Surface))
 }
 
 /// Rank 0's check against the whole data rendered in one process.
-fn check(composited: &Frame, o: &Args) -> anyhow::Result<()> {
-    write_png(composited, &o.out)?;
-    let whole = surface::single(&o.surface_job())?;
-    let bits = |p: &Pixel| (p.color.map(f32::to_bits), p.depth.to_bits());
-    let differ =
-        composited.pixels().iter().zip(whole.pixels()).filter(|(a, b)| bits(a) != bits(b)).count();
-    let covered = whole.pixels().iter().filter(|p| p.depth.is_finite()).count();
+fn check(image: &Image, o: &Args) -> anyhow::Result<()> {
+    let out = o.out();
+    let (differ, covered, size) = match image {
+        Image::Surface(composited) => {
+            write_png(composited, &out)?;
+            let whole = surface::single(&o.surface_job())?;
+            let bits = |p: &Pixel| (p.color.map(f32::to_bits), p.depth.to_bits());
+            let differ = composited
+                .pixels()
+                .iter()
+                .zip(whole.pixels())
+                .filter(|(a, b)| bits(a) != bits(b))
+                .count();
+            let covered = whole.pixels().iter().filter(|p| p.depth.is_finite()).count();
+            (differ, covered, (composited.width(), composited.height()))
+        }
+        Image::Volume(film, job) => {
+            write_png(&film_frame(film, 1.0)?, &out)?;
+            let whole = volume::single(job)?;
+            let differ = if volume::same(film, &whole) {
+                0
+            } else {
+                let (a, b) = (film.normalized(), whole.normalized());
+                a.iter()
+                    .zip(&b)
+                    .filter(|(p, q)| p.map(f32::to_bits) != q.map(f32::to_bits))
+                    .count()
+                    .max(1)
+            };
+            let size = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+            (differ, film.width() * film.height(), (size(film.width()), size(film.height())))
+        }
+    };
     println!(
-        "wrote {}: {}×{}, {covered} pixels covered; differs from the single-process render in {differ} pixels (depth and colour compared bit for bit)",
-        o.out.display(),
-        o.size.0,
-        o.size.1
+        "wrote {}: {}×{}, {covered} pixels covered; differs from the single-process render in {differ} pixels (compared bit for bit)",
+        out.display(),
+        size.0,
+        size.1
     );
     if covered == 0 {
         bail!("nothing in view");
@@ -161,6 +309,7 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
     let world = universe.world();
     let comm = MpiComm::new(&world, std::time::Duration::from_secs(60));
     let result = rank_main(&comm, o).and_then(|f| f.map_or(Ok(()), |f| check(&f, o)));
+    std::fs::remove_dir_all(scratch(comm.rank())).ok();
     // Every rank learns whether rank 0's check passed.
     let mut ok = u8::from(result.is_ok());
     rt_composite::mpi::traits::Root::broadcast_into(&world.process_at_rank(0), &mut ok);
@@ -180,7 +329,7 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
 pub fn run(o: &Args) -> anyhow::Result<()> {
     use rt_composite::ThreadComm;
     let comms = ThreadComm::group(o.ranks as usize, std::time::Duration::from_secs(60));
-    let results: Vec<anyhow::Result<Option<Frame>>> = std::thread::scope(|s| {
+    let results: Vec<anyhow::Result<Option<Image>>> = std::thread::scope(|s| {
         let handles: Vec<_> =
             comms.into_iter().map(|c| s.spawn(move || rank_main(&c, o))).collect();
         handles
@@ -188,11 +337,12 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
             .map(|h| h.join().unwrap_or_else(|_| Err(anyhow!("a rank panicked"))))
             .collect()
     });
-    let mut image = None;
-    for r in results {
-        if let Some(f) = r? {
-            image = Some(f);
-        }
+    let checked = results.into_iter().collect::<anyhow::Result<Vec<_>>>().and_then(|images| {
+        let image = images.into_iter().flatten().next();
+        check(&image.ok_or_else(|| anyhow!("no rank returned the image"))?, o)
+    });
+    for rank in 0..o.ranks as usize {
+        std::fs::remove_dir_all(scratch(rank)).ok();
     }
-    check(&image.ok_or_else(|| anyhow!("no rank returned the image"))?, o)
+    checked
 }

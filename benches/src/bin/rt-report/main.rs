@@ -12,6 +12,7 @@
 //! cargo run --release -p rt-benches --bin rt-report -- render [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- composite [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- unstructured [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- distributed [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- gl [--quick]         # needs xvfb-run, cc, glxgears
 //! cargo run --release -p rt-benches --bin rt-report -- all [--quick]   # + index.md
 //! ```
@@ -20,6 +21,7 @@
 
 mod bos;
 mod composite;
+mod distributed;
 #[cfg(feature = "embree3")]
 mod embree3;
 mod focusing;
@@ -108,7 +110,7 @@ const USAGE: &str = "usage: rt-report [AREA ...] [--quick]
 
 Writes tables, CSV files and plots under target/rt-report/.
 AREA: traversal, grin, octree, schlieren, noise, bos, focusing, render,
-composite, unstructured (none or
+composite, unstructured, distributed (none or
 `all`: every one of these, plus target/rt-report/index.md), or gl (rt-gl
 against Mesa; needs xvfb-run, cc and glxgears; not part of `all`).
 --quick: smaller problems, fewer repetitions (checks the pipeline, not the
@@ -124,7 +126,12 @@ and the rays that did not leave the far side) and
 unstructured_throughput.csv (method,case,cells,build_seconds,rays,threads,
 seconds,photons_per_s,cells_crossed,cells_per_s: a 256x256 beam through
 the N = 64 mesh, 1.57M tetrahedra, one thread and all cores;
-cells_crossed = sum of TraceStats::steps, the tetrahedra crossed).";
+cells_crossed = sum of TraceStats::steps, the tetrahedra crossed).
+
+distributed writes distributed.csv (kind,ranks,seconds,items_sent,
+bytes_sent,messages,identical_to_single: surfaces with shadows and AO and
+the blast wave's knife-edge schlieren on 1, 2, 4, 8, 16 in-process ranks;
+items are occlusion rays or photons sent between ranks).";
 
 fn main() -> ExitCode {
     let t0 = std::time::Instant::now();
@@ -153,6 +160,7 @@ fn main() -> ExitCode {
             "render",
             "composite",
             "unstructured",
+            "distributed",
         ]
     } else {
         areas
@@ -175,9 +183,10 @@ fn main() -> ExitCode {
             "render" => render::run(&dir, quick),
             "composite" => composite::run(&dir, quick),
             "unstructured" => unstructured::run(&dir, quick),
+            "distributed" => distributed::run(&dir, quick),
             "gl" => gl::run(&dir, quick),
             other => Err(format!(
-                "unknown area `{other}` (known: traversal, grin, octree, schlieren, noise, bos, focusing, render, composite, unstructured, gl, all)"
+                "unknown area `{other}` (known: traversal, grin, octree, schlieren, noise, bos, focusing, render, composite, unstructured, distributed, gl, all)"
             )),
         };
         match result {
