@@ -17,8 +17,10 @@
 //! - `rt view MESH`: a ray-traced picture of a mesh (OBJ, PLY, VTK)
 //!   coloured by one of its scalars;
 //! - `rt info FILE`: what a volume or mesh holds;
-//! - `rt distributed`: sort-last rendering across ranks (threads, or MPI
-//!   processes with feature `mpi`), checked bit for bit.
+//! - `rt distributed`: rendering across ranks (threads, or MPI processes
+//!   with feature `mpi`), checked bit for bit: a terrain with shadows and
+//!   AO answered across ranks, or a volume's photons handed between
+//!   bricks.
 //!
 //! Errors are one line (`rt: error: …`) with a non-zero exit; `--help` on
 //! every subcommand gives each option with its unit and default.
@@ -73,8 +75,9 @@ pub enum Command {
     View(view::Args),
     /// Describe a volume or mesh file: size, geometry, value ranges.
     Info(info::Args),
-    /// Render a terrain on several ranks and composite the frames by
-    /// depth, checked against one process bit for bit.
+    /// Render data split across ranks, checked against one process bit
+    /// for bit: a terrain (shadow and AO rays answered by every rank) or
+    /// a volume (photons handed between bricks).
     Distributed(distributed::Args),
 }
 

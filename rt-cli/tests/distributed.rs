@@ -8,7 +8,7 @@ use rt_cli::distributed::{
     surface::{self, SurfaceJob},
     volume,
 };
-use rt_composite::{Schedule, ThreadComm};
+use rt_composite::{Communicator as _, Schedule, ThreadComm};
 use rt_core::{Frame, Pixel};
 
 fn bits(f: &Frame) -> Vec<([u32; 4], u32)> {
@@ -130,6 +130,82 @@ fn volumes_equal_one_process_bit_for_bit_and_no_rank_holds_the_grid() {
             if ranks >= 4 {
                 assert!(handed > 0, "{ranks} ranks: no photon crossed a brick");
             }
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A rank whose messages stop arriving after its first `after` (it keeps
+/// running, so only the timeout can tell its peers).
+struct GoesSilent {
+    inner: ThreadComm,
+    after: usize,
+    sent: core::cell::Cell<usize>,
+}
+
+impl rt_composite::Communicator for GoesSilent {
+    fn rank(&self) -> usize {
+        self.inner.rank()
+    }
+    fn size(&self) -> usize {
+        self.inner.size()
+    }
+    fn send(&self, to: usize, tag: u32, data: Vec<u8>) -> Result<(), rt_composite::CommError> {
+        self.sent.set(self.sent.get() + 1);
+        if self.sent.get() > self.after {
+            return Ok(());
+        }
+        self.inner.send(to, tag, data)
+    }
+    fn recv(&self, from: usize, tag: u32) -> Result<Vec<u8>, rt_composite::CommError> {
+        self.inner.recv(from, tag)
+    }
+}
+
+/// Rank 2 of 4 stops answering in the middle of the work: its first nine
+/// messages arrive (the two rounds that share the regions or the field's
+/// extremes, then the first round of occlusion queries or photons), the
+/// rest never do. Every rank returns an `Err` within about the timeout,
+/// and none hangs.
+#[test]
+fn a_rank_that_stops_answering_is_an_error_on_every_rank() {
+    let dir = std::env::temp_dir().join(format!("rt-cli-test-silent-{}", std::process::id()));
+    let vjob = volume::VolumeJob::builtin(&dir, 32, 1).unwrap();
+    let sjob = SurfaceJob {
+        size: (64, 48),
+        grid: 33,
+        shadows: true,
+        ao: 2,
+        ao_distance: None,
+        seed: 1,
+        schedule: Schedule::BinarySwap,
+    };
+    let timeout = Duration::from_millis(500);
+    for kind in ["surface", "volume"] {
+        let comms = ThreadComm::group(4, timeout);
+        let t0 = std::time::Instant::now();
+        let failed: Vec<(bool, Duration)> = std::thread::scope(|s| {
+            let handles: Vec<_> = comms
+                .into_iter()
+                .map(|c| {
+                    let after = if c.rank() == 2 { 9 } else { usize::MAX };
+                    let c = GoesSilent { inner: c, after, sent: core::cell::Cell::new(0) };
+                    let (sjob, vjob) = (&sjob, &vjob);
+                    s.spawn(move || {
+                        let err = if kind == "surface" {
+                            surface::rank(&c, sjob).is_err()
+                        } else {
+                            volume::rank(&c, vjob).is_err()
+                        };
+                        (err, t0.elapsed())
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().expect("rank panicked")).collect()
+        });
+        for (r, (err, at)) in failed.iter().enumerate() {
+            assert!(err, "{kind}: rank {r} did not fail");
+            assert!(*at < Duration::from_secs(10), "{kind}: rank {r} took {at:?}");
         }
     }
     std::fs::remove_dir_all(&dir).ok();

@@ -58,6 +58,14 @@ fn schedule(s: &str) -> Result<Schedule, String> {
     }
 }
 
+/// Seconds, more than 0 and at most a week.
+fn timeout(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= 604_800.0 => Ok(v),
+        _ => Err(format!("`{s}`: seconds, more than 0 and at most 604800 (a week)")),
+    }
+}
+
 /// A positive, finite length.
 fn positive(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
@@ -93,6 +101,10 @@ pub struct Args {
     /// Seed of the AO directions.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Seconds a rank waits for another before giving up (a rank that
+    /// stops answering is then an error on every rank, never a hang).
+    #[arg(long, default_value_t = 60.0, value_parser = timeout)]
+    pub timeout: f64,
     /// Compositing schedule: direct-send, binary-swap or radix-K (K ≥ 2).
     #[arg(long, value_parser = schedule, default_value = "binary-swap")]
     pub schedule: Schedule,
@@ -307,7 +319,7 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
     let universe =
         rt_composite::mpi::initialize().ok_or_else(|| anyhow!("MPI was already initialised"))?;
     let world = universe.world();
-    let comm = MpiComm::new(&world, std::time::Duration::from_secs(60));
+    let comm = MpiComm::new(&world, std::time::Duration::from_secs_f64(o.timeout));
     let result = rank_main(&comm, o).and_then(|f| f.map_or(Ok(()), |f| check(&f, o)));
     std::fs::remove_dir_all(scratch(comm.rank())).ok();
     // Every rank learns whether rank 0's check passed.
@@ -328,7 +340,7 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
 #[cfg(not(feature = "mpi"))]
 pub fn run(o: &Args) -> anyhow::Result<()> {
     use rt_composite::ThreadComm;
-    let comms = ThreadComm::group(o.ranks as usize, std::time::Duration::from_secs(60));
+    let comms = ThreadComm::group(o.ranks as usize, std::time::Duration::from_secs_f64(o.timeout));
     let results: Vec<anyhow::Result<Option<Image>>> = std::thread::scope(|s| {
         let handles: Vec<_> =
             comms.into_iter().map(|c| s.spawn(move || rank_main(&c, o))).collect();

@@ -140,6 +140,13 @@ impl VolumeJob {
     /// The whole grid's header, and the index outside the volume (its
     /// first sample's, as `rt schlieren` takes it).
     fn header(&self) -> anyhow::Result<(GridInfo, f64)> {
+        let ext = self.file.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        if !matches!(ext.as_deref(), Some("json" | "raw" | "nrrd" | "nhdr")) {
+            bail!(
+                "{}: a distributed volume is read a brick at a time, from raw + JSON (.json) or NRRD with raw encoding (.nrrd, .nhdr)",
+                self.file.display()
+            );
+        }
         let info = io::read_grid_info(&self.file)?;
         let first = self.read_box([0; 3], [1; 3])?;
         let ambient = f64::from(first.data()[0]);
