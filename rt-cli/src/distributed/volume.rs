@@ -380,36 +380,6 @@ fn get_result(w: &mut Words<'_>) -> Option<(Key, TraceResult)> {
     Some((k, r))
 }
 
-/// Largest index and gradient magnitude the brick's samples imply (the
-/// gradient from neighbour differences, doubled for the cubic's
-/// overshoot).
-fn brick_extremes(g: &Grid) -> (f64, f64) {
-    let d = g.dims();
-    let s = g.spacing();
-    let at = |i: usize, j: usize, k: usize| f64::from(g.data()[i + d[0] * (j + d[1] * k)]);
-    let (mut n_max, mut grad) = (0f64, 0f64);
-    for k in 0..d[2] {
-        for j in 0..d[1] {
-            for i in 0..d[0] {
-                let v = at(i, j, k);
-                n_max = n_max.max(v);
-                let mut g2 = 0.0;
-                if i + 1 < d[0] {
-                    g2 += ((at(i + 1, j, k) - v) / s.x).powi(2);
-                }
-                if j + 1 < d[1] {
-                    g2 += ((at(i, j + 1, k) - v) / s.y).powi(2);
-                }
-                if k + 1 < d[2] {
-                    g2 += ((at(i, j, k + 1) - v) / s.z).powi(2);
-                }
-                grad = grad.max(g2.sqrt());
-            }
-        }
-    }
-    (n_max, 2.0 * grad)
-}
-
 /// Reads this rank's brick with enough ghost layers for every step: first
 /// with a reach for `n ≤ 2` and a gentle gradient, then, once every
 /// rank's largest index and gradient are known, again if that was short.
@@ -425,8 +395,8 @@ fn load_brick<C: Communicator>(
     loop {
         let (lo, hi) = bricks.samples_needed(me, reach, job.interp)?;
         let samples = job.read_box(lo, hi)?;
-        let (n_max, grad) = brick_extremes(&samples);
-        let mine: Vec<u8> = [n_max, grad].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let b = samples.index_bounds(job.interp);
+        let mine: Vec<u8> = [b.n_max, b.grad_max].iter().flat_map(|v| v.to_le_bytes()).collect();
         let (all, _) = all_gather(comm, &mine).map_err(|e| anyhow!("rank {me}: {e}"))?;
         let (mut n_all, mut g_all) = (ambient, 0f64);
         for (r, b) in all.iter().enumerate() {
