@@ -15,23 +15,31 @@ fn bits(f: &Frame) -> Vec<([u32; 4], u32)> {
     f.pixels().iter().map(|p: &Pixel| (p.color.map(f32::to_bits), p.depth.to_bits())).collect()
 }
 
-/// Rank 0's image and every rank's report.
-fn surfaces(job: &SurfaceJob, ranks: usize) -> (Frame, Vec<surface::SurfaceRank>) {
+/// Runs `f` on `ranks` thread ranks: rank 0's result and every rank's
+/// report (only rank 0 may have a result).
+fn on_ranks<T: Send, R: Send>(
+    ranks: usize,
+    f: impl Fn(&ThreadComm) -> anyhow::Result<(Option<T>, R)> + Sync,
+) -> (T, Vec<R>) {
     let comms = ThreadComm::group(ranks, Duration::from_secs(60));
+    let f = &f;
     let out: Vec<_> = std::thread::scope(|s| {
-        let handles: Vec<_> =
-            comms.into_iter().map(|c| s.spawn(move || surface::rank(&c, job))).collect();
+        let handles: Vec<_> = comms.into_iter().map(|c| s.spawn(move || f(&c))).collect();
         handles.into_iter().map(|h| h.join().expect("rank panicked")).collect()
     });
-    let mut image = None;
+    let mut first = None;
     let mut reports = Vec::new();
     for (r, o) in out.into_iter().enumerate() {
         let (img, rep) = o.unwrap_or_else(|e| panic!("{ranks} ranks, rank {r}: {e:#}"));
         assert_eq!(img.is_some(), r == 0);
-        image = image.or(img);
+        first = first.or(img);
         reports.push(rep);
     }
-    (image.expect("rank 0's image"), reports)
+    (first.expect("rank 0's result"), reports)
+}
+
+fn surfaces(job: &SurfaceJob, ranks: usize) -> (Frame, Vec<surface::SurfaceRank>) {
+    on_ranks(ranks, |c| surface::rank(c, job))
 }
 
 #[test]
@@ -69,23 +77,8 @@ fn surfaces_with_shadows_and_ao_equal_one_process_bit_for_bit() {
     }
 }
 
-/// Rank 0's film and every rank's report for a volume job.
 fn volumes(job: &volume::VolumeJob, ranks: usize) -> (rt_photo::Film, Vec<volume::VolumeRank>) {
-    let comms = ThreadComm::group(ranks, Duration::from_secs(60));
-    let out: Vec<_> = std::thread::scope(|s| {
-        let handles: Vec<_> =
-            comms.into_iter().map(|c| s.spawn(move || volume::rank(&c, job))).collect();
-        handles.into_iter().map(|h| h.join().expect("rank panicked")).collect()
-    });
-    let mut film = None;
-    let mut reports = Vec::new();
-    for (r, o) in out.into_iter().enumerate() {
-        let (f, rep) = o.unwrap_or_else(|e| panic!("{ranks} ranks, rank {r}: {e:#}"));
-        assert_eq!(f.is_some(), r == 0);
-        film = film.or(f);
-        reports.push(rep);
-    }
-    (film.expect("rank 0's film"), reports)
+    on_ranks(ranks, |c| volume::rank(c, job))
 }
 
 /// Knife-edge schlieren and interferometry of the blast wave, photons

@@ -38,6 +38,21 @@ struct Row {
     largest_brick: usize,
 }
 
+impl Row {
+    fn new(kind: &'static str, ranks: usize) -> Self {
+        Self {
+            kind,
+            ranks,
+            samples: Samples::default(),
+            items: 0,
+            bytes: 0,
+            messages: 0,
+            identical: true,
+            largest_brick: 0,
+        }
+    }
+}
+
 fn same(a: &Frame, b: &Frame) -> bool {
     a.pixels().iter().zip(b.pixels()).all(|(p, q)| {
         p.depth.to_bits() == q.depth.to_bits()
@@ -75,16 +90,7 @@ fn surface_rows(quick: bool, ranks: &[usize], reps: usize) -> Result<Vec<Row>, S
     let whole = surface::single(&job).map_err(|e| format!("{e:#}"))?;
     let mut rows = Vec::new();
     for &n in ranks {
-        let mut row = Row {
-            kind: "surface",
-            ranks: n,
-            samples: Samples::default(),
-            items: 0,
-            bytes: 0,
-            messages: 0,
-            identical: true,
-            largest_brick: 0,
-        };
+        let mut row = Row::new("surface", n);
         for _ in 0..reps {
             let (secs, out) = time(|| on_ranks(n, |c| surface::rank(c, &job)));
             let out = out?;
@@ -108,16 +114,7 @@ fn volume_rows(quick: bool, ranks: &[usize], reps: usize) -> Result<Vec<Row>, St
     let whole = volume::single(&job).map_err(|e| format!("{e:#}"))?;
     let mut rows = Vec::new();
     for &n in ranks {
-        let mut row = Row {
-            kind: "volume",
-            ranks: n,
-            samples: Samples::default(),
-            items: 0,
-            bytes: 0,
-            messages: 0,
-            identical: true,
-            largest_brick: 0,
-        };
+        let mut row = Row::new("volume", n);
         for _ in 0..reps {
             let (secs, out) = time(|| on_ranks(n, |c| volume::rank(c, &job)));
             let out = out?;
