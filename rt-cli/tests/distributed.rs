@@ -125,6 +125,20 @@ fn volumes_equal_one_process_bit_for_bit_and_no_rank_holds_the_grid() {
             }
         }
     }
+    // Bounded buffers: with 50 photons a round, no message exceeds what 50
+    // hand-offs and 50 results take, though over a thousand photons cross
+    // (in more rounds); the film is still the same.
+    let small = volume::VolumeJob { batch: 50, ..knife.clone() };
+    let whole = volume::single(&small).unwrap();
+    let (film, reports) = volumes(&small, 4);
+    assert!(volume::same(&film, &whole));
+    let handed: u64 = reports.iter().map(|r| r.handed_off).sum();
+    assert!(handed > 1000, "{handed}");
+    for r in &reports {
+        let longest = r.exchange.largest_message as usize;
+        assert!(longest <= small.largest_message(), "{longest} > {}", small.largest_message());
+        assert!(r.exchange.rounds > 8, "{} rounds", r.exchange.rounds);
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
 

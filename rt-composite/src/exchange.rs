@@ -48,6 +48,9 @@ pub struct ExchangeStats {
     pub messages: u64,
     /// Bytes this rank sent, headers included.
     pub bytes_sent: u64,
+    /// The longest message this rank sent, in bytes (what its send
+    /// buffers must hold at once for one peer).
+    pub largest_message: u64,
 }
 
 impl ExchangeStats {
@@ -56,6 +59,7 @@ impl ExchangeStats {
         self.rounds += o.rounds;
         self.messages += o.messages;
         self.bytes_sent += o.bytes_sent;
+        self.largest_message = self.largest_message.max(o.largest_message);
     }
 }
 
@@ -159,6 +163,7 @@ where
             msg.extend(batch);
             stats.messages += 1;
             stats.bytes_sent += msg.len() as u64;
+            stats.largest_message = stats.largest_message.max(msg.len() as u64);
             if let Err(e) = comm.send(peer, EXCHANGE_TAG, msg) {
                 abort(&mut stats);
                 return Err(ExchangeError::Comm(e));

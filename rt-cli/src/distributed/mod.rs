@@ -186,6 +186,7 @@ impl Args {
             size: self.size.0,
             strata: self.strata,
             seed: self.seed,
+            batch: volume::BATCH,
         })
     }
 

@@ -55,8 +55,17 @@ use rt_volume::{
 use crate::optics::Quantity;
 
 /// Photons a rank advances per round, and most results it sends rank 0
-/// per round: this bounds its message buffers (264 bytes a photon).
+/// per round, by default: this bounds its message buffers (see
+/// [`VolumeJob::largest_message`]).
 pub const BATCH: usize = 1 << 14;
+
+/// Bytes of a photon handed over: its identity (6 words) and its
+/// [`PathState`].
+pub const PHOTON_BYTES: usize = 8 * (6 + PathState::WORDS);
+
+/// Bytes of a finished photon's result sent to rank 0: its identity and
+/// 15 words of [`TraceResult`].
+pub const RESULT_BYTES: usize = 8 * (6 + 15);
 
 /// What a volume render records.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -95,6 +104,9 @@ pub struct VolumeJob {
     pub strata: u32,
     /// Seed of the photons' placement.
     pub seed: u64,
+    /// Most photons a rank advances, and most results it sends rank 0,
+    /// per round ([`BATCH`] by default).
+    pub batch: usize,
 }
 
 impl VolumeJob {
@@ -115,7 +127,17 @@ impl VolumeJob {
             size,
             strata,
             seed: 1,
+            batch: BATCH,
         })
+    }
+
+    /// The longest message a rank can send: one round's hand-offs to one
+    /// peer and, to rank 0, one round's results, with their counts and
+    /// the two-byte header. Whatever the photon count.
+    #[must_use]
+    pub fn largest_message(&self) -> usize {
+        let batch = self.batch.max(1);
+        2 + 8 + batch * PHOTON_BYTES + 8 + batch * RESULT_BYTES
     }
 
     fn to_index(&self, grid: Grid) -> anyhow::Result<Grid> {
@@ -486,7 +508,7 @@ pub fn rank<C: Communicator>(
                 return Err(bad());
             }
         }
-        let take = queue.len().min(BATCH);
+        let take = queue.len().min(job.batch.max(1));
         let batch: Vec<(Key, PathState)> = queue.split_off(queue.len() - take);
         let legs: Vec<(Key, Result<Leg, rt_volume::TraceError>)> =
             batch.into_par_iter().map(|(k, s)| (k, trace_leg(&field, s, &params, owns))).collect();
@@ -504,7 +526,7 @@ pub fn rank<C: Communicator>(
                 Err(e) => return Err(format!("rank {me}: {e}")),
             }
         }
-        let send_now = done.len().min(BATCH);
+        let send_now = done.len().min(job.batch.max(1));
         let finished: Vec<(Key, TraceResult)> = done.split_off(done.len() - send_now);
         if me == 0 {
             results.extend(finished.iter().copied());

@@ -36,6 +36,8 @@ struct Row {
     identical: bool,
     /// Largest brick any rank held, in samples (volumes).
     largest_brick: usize,
+    /// Longest message any rank sent, in bytes.
+    largest_message: u64,
 }
 
 impl Row {
@@ -49,6 +51,7 @@ impl Row {
             messages: 0,
             identical: true,
             largest_brick: 0,
+            largest_message: 0,
         }
     }
 }
@@ -98,6 +101,8 @@ fn surface_rows(quick: bool, ranks: &[usize], reps: usize) -> Result<Vec<Row>, S
             row.items = out.iter().map(|(_, r)| r.occlusion.sent).sum();
             row.bytes = out.iter().map(|(_, r)| r.occlusion.exchange.bytes_sent).sum();
             row.messages = out.iter().map(|(_, r)| r.occlusion.exchange.messages).sum();
+            row.largest_message =
+                out.iter().map(|(_, r)| r.occlusion.exchange.largest_message).max().unwrap_or(0);
             let image = out.iter().find_map(|(f, _)| f.as_ref()).ok_or("no image")?;
             row.identical &= same(image, &whole);
         }
@@ -122,6 +127,8 @@ fn volume_rows(quick: bool, ranks: &[usize], reps: usize) -> Result<Vec<Row>, St
             row.items = out.iter().map(|(_, r)| r.handed_off).sum();
             row.bytes = out.iter().map(|(_, r)| r.exchange.bytes_sent).sum();
             row.messages = out.iter().map(|(_, r)| r.exchange.messages).sum();
+            row.largest_message =
+                out.iter().map(|(_, r)| r.exchange.largest_message).max().unwrap_or(0);
             row.largest_brick = out.iter().map(|(_, r)| r.brick_samples).max().unwrap_or(0);
             let image = out.iter().find_map(|(f, _)| f.as_ref()).ok_or("no image")?;
             row.identical &= volume::same(image, &whole);
@@ -140,7 +147,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let mut csv =
         String::from("kind,ranks,seconds,items_sent,bytes_sent,messages,identical_to_single\n");
     let mut md = String::from(
-        "| kind | ranks | seconds (best) | spread | vs 1 rank | items sent | MB sent | messages | largest brick (samples) | identical |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        "| kind | ranks | seconds (best) | spread | vs 1 rank | items sent | MB sent | messages | longest message (KB) | largest brick (samples) | identical |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut series = Vec::new();
     let mut verdicts = Vec::new();
@@ -158,7 +165,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             let brick = if r.kind == "volume" { r.largest_brick.to_string() } else { "—".into() };
             writeln!(
                 md,
-                "| {} | {} | {secs:.3} | +{:.0}% | {:.2} | {} | {:.2} | {} | {brick} | {} |",
+                "| {} | {} | {secs:.3} | +{:.0}% | {:.2} | {} | {:.2} | {} | {:.1} | {brick} | {} |",
                 r.kind,
                 r.ranks,
                 r.samples.spread(),
@@ -166,6 +173,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
                 r.items,
                 r.bytes as f64 / 1e6,
                 r.messages,
+                r.largest_message as f64 / 1e3,
                 r.identical
             )
             .unwrap();
