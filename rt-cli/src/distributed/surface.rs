@@ -125,7 +125,7 @@ fn setup(job: &SurfaceJob, whole: Aabb) -> anyhow::Result<(Camera, Settings)> {
     let settings = Settings {
         lights: vec![
             Light::Ambient { color: [0.35; 3] },
-            Light::Directional { direction: Vec3::new(-0.5, 1.0, 0.35), color: [0.75; 3] },
+            Light::Directional { direction: Vec3::new(-0.9, 0.5, 0.35), color: [0.75; 3] },
         ],
         shadows: job.shadows,
         ao_samples: job.ao,
