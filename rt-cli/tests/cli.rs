@@ -105,6 +105,20 @@ fn bad_files_are_one_line_errors() {
     .unwrap();
     fails_with(&rt(&["view", ply.to_str().unwrap()]), &["nan.ply", "malformed mesh file"]);
     fails_with(&rt(&["info", ply.to_str().unwrap()]), &["nan.ply"]);
+    // Distributed: a volume that cannot be read a brick at a time, and
+    // jobs too large to hold are one-line errors, not a crash.
+    fails_with(
+        &rt(&["distributed", "--volume", ply.to_str().unwrap()]),
+        &["nan.ply", "a brick at a time"],
+    );
+    fails_with(
+        &rt(&["distributed", "--volume", "--size", "16384x16384", "--ranks", "2"]),
+        &["photons is more than a distributed run traces"],
+    );
+    fails_with(
+        &rt(&["distributed", "--size", "16384x16384", "--ao", "4096"]),
+        &["shadow and AO rays is more than"],
+    );
     let negative = bump_volume(&dir, true);
     fails_with(
         &rt(&["schlieren", negative.to_str().unwrap()]),

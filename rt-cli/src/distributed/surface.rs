@@ -69,6 +69,27 @@ pub struct SurfaceRank {
 /// Queries per peer per round (32 bytes each: at most 2 MiB a message).
 const BATCH: usize = 1 << 16;
 
+/// The most occlusion rays one run may record (32 bytes each, held twice
+/// while they are sorted and answered).
+pub const MAX_OCCLUSION_RAYS: u64 = 1 << 26;
+
+impl SurfaceJob {
+    /// Refuses a job whose occlusion rays would not fit in memory.
+    ///
+    /// # Errors
+    /// More than [`MAX_OCCLUSION_RAYS`] rays.
+    pub fn check(&self) -> anyhow::Result<()> {
+        let pixels = u64::from(self.size.0) * u64::from(self.size.1);
+        let rays = pixels * (u64::from(self.ao) + u64::from(self.shadows));
+        if rays > MAX_OCCLUSION_RAYS {
+            bail!(
+                "{rays} shadow and AO rays is more than a distributed run records ({MAX_OCCLUSION_RAYS}); lower --size or --ao"
+            );
+        }
+        Ok(())
+    }
+}
+
 /// The whole terrain, coloured by height, and the colour map's range.
 fn terrain(grid: u32) -> anyhow::Result<(Mesh, (f32, f32))> {
     let t = scenes::terrain(grid);
@@ -142,6 +163,7 @@ fn setup(job: &SurfaceJob, whole: Aabb) -> anyhow::Result<(Camera, Settings)> {
 /// # Errors
 /// Bad settings (e.g. a non-positive AO distance).
 pub fn single(job: &SurfaceJob) -> anyhow::Result<Frame> {
+    job.check()?;
     let (mesh, range) = terrain(job.grid)?;
     let world = scene(mesh, range)?;
     let (cam, settings) = setup(job, rt_surface::ShadeScene::bounds(&world))?;
@@ -170,6 +192,7 @@ pub fn rank<C: Communicator>(
     job: &SurfaceJob,
 ) -> anyhow::Result<(Option<Frame>, SurfaceRank)> {
     let (me, ranks) = (comm.rank(), comm.size());
+    job.check()?;
     let mut report = SurfaceRank::default();
     let (mesh, range) = terrain(job.grid)?;
     let mine = share(&mesh, me, ranks)?;

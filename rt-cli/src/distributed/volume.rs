@@ -59,6 +59,10 @@ use crate::optics::Quantity;
 /// [`VolumeJob::largest_message`]).
 pub const BATCH: usize = 1 << 14;
 
+/// The most photons one distributed run traces (each rank lists their
+/// 48-byte identities once while it finds its own).
+pub const MAX_PHOTONS: u64 = 1 << 25;
+
 /// Bytes of a photon handed over: its identity (6 words) and its
 /// [`PathState`].
 pub const PHOTON_BYTES: usize = 8 * (6 + PathState::WORDS);
@@ -207,8 +211,17 @@ impl VolumeJob {
         }
     }
 
+    /// The film, refusing more photons than [`MAX_PHOTONS`] (every rank
+    /// lists their identities once).
     fn film(&self, bench: &Bench) -> anyhow::Result<Film> {
         let height = (f64::from(self.size) * bench.height / bench.width).round().max(1.0) as usize;
+        let side = |n: usize| (n as u64).saturating_mul(u64::from(self.strata)).saturating_add(2);
+        let photons = side(self.size as usize).saturating_mul(side(height));
+        if photons > MAX_PHOTONS {
+            bail!(
+                "{photons} photons is more than a distributed run traces ({MAX_PHOTONS}); lower --size or --strata"
+            );
+        }
         Ok(Film::new(self.size as usize, height, Filter::Tent)?)
     }
 }
