@@ -190,8 +190,8 @@ pub fn resolve_occlusion<C: Communicator + ?Sized>(
     // `r + 1`, which this rank reads in round `r + 2`.
     let mut waiting: Vec<[Vec<usize>; 2]> = vec![[Vec::new(), Vec::new()]; size];
     let mut open = ready.len();
-    // Queries received last round, to answer this round.
-    let mut owed: Vec<Vec<bool>> = vec![Vec::new(); size];
+    // Queries received this round (answered in this round's messages),
+    // and how many came from each peer.
     let mut received: Vec<Ray> = Vec::new();
     let mut counts: Vec<usize> = vec![0; size];
     let step = |round: u32, inbox: &[Batch], outbox: &mut [Vec<u8>]| {
@@ -235,15 +235,10 @@ pub fn resolve_occlusion<C: Communicator + ?Sized>(
             }
             counts[from] = queries;
         }
+        let mut answers = vec![false; received.len()];
         if !received.is_empty() {
-            let mut bits = vec![false; received.len()];
-            test(&received, &mut bits);
+            test(&received, &mut answers);
             stats.answered += received.len() as u64;
-            let mut at = 0;
-            for (from, &n) in counts.iter().enumerate() {
-                owed[from].extend_from_slice(&bits[at..at + n]);
-                at += n;
-            }
         }
         // New queries: each open ray to the next rank on its route, or
         // settled as open when the route is done.
@@ -260,8 +255,10 @@ pub fn resolve_occlusion<C: Communicator + ?Sized>(
             sent += 1;
         }
         stats.sent += sent as u64;
+        let mut at = 0;
         for (peer, out) in outbox.iter_mut().enumerate() {
-            let answers = core::mem::take(&mut owed[peer]);
+            let answers = &answers[at..at + counts[peer]];
+            at += counts[peer];
             if answers.is_empty() && new[peer].is_empty() {
                 continue;
             }

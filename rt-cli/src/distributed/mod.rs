@@ -66,14 +66,6 @@ fn timeout(s: &str) -> Result<f64, String> {
     }
 }
 
-/// A positive, finite length.
-fn positive(s: &str) -> Result<f32, String> {
-    match s.parse::<f32>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("`{s}`: must be a finite number > 0")),
-    }
-}
-
 /// `rt distributed`: options.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -96,8 +88,8 @@ pub struct Args {
     pub ao: u32,
     /// Longest AO ray, in scene units [default: 5 % of the scene's
     /// diagonal].
-    #[arg(long, value_parser = positive)]
-    pub ao_distance: Option<f32>,
+    #[arg(long, value_parser = parse::positive)]
+    pub ao_distance: Option<f64>,
     /// Seed of the AO directions.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -196,7 +188,7 @@ impl Args {
             grid: self.grid,
             shadows: self.shadows,
             ao: self.ao,
-            ao_distance: self.ao_distance,
+            ao_distance: self.ao_distance.map(|d| d as f32),
             seed: self.seed,
             schedule: self.schedule,
         }
