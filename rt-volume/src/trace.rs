@@ -620,18 +620,15 @@ fn leg<F: IndexField>(
     };
     stats.field_evals = ev.evals;
     stats.invariant_drift = stats.invariant_drift.max((y.t.length() - n).abs());
-    if !(y.x.is_finite() && y.t.is_finite() && y.opl.is_finite()) {
+    // `T = 0` after a step (a state off the network with a subnormal `T`,
+    // found by the `distributed` fuzz target) has no direction.
+    let direction = unit(y.t);
+    if !(y.x.is_finite() && y.t.is_finite() && y.opl.is_finite() && direction.is_finite()) {
         // n near f64's range (found by fuzzing with n ≈ 1e38): the optical
         // path or momentum overflowed.
         return Err(TraceError::BadField { at: y.x });
     }
-    Ok(Leg::Finished(TraceResult {
-        position: y.x,
-        direction: unit(y.t),
-        optical_path: y.opl,
-        exit,
-        stats,
-    }))
+    Ok(Leg::Finished(TraceResult { position: y.x, direction, optical_path: y.opl, exit, stats }))
 }
 
 /// One step of size `h` (for `Adaptive`: one uncontrolled Dormand–Prince
