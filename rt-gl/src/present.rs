@@ -57,13 +57,14 @@ fn present_frame(buffer: u32) {
     if let Some(dir) = &cfg.dump {
         let c = counters;
         let line = format!(
-            "frames={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_inline={} instances={} triangles={} ignored={}\n",
+            "frames={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_refits={} draw_inline={} instances={} triangles={} ignored={}\n",
             c.frames,
             c.list_builds,
             c.list_reuses,
             c.list_inline,
             c.draw_builds,
             c.draw_reuses,
+            c.draw_refits,
             c.draw_inline,
             c.instances,
             c.triangles,

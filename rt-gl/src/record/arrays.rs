@@ -6,13 +6,17 @@
 //! copy them), so a draw whose arrays and indices all live in buffer
 //! objects is recorded once and instanced while the buffers keep their
 //! contents; draws from client memory are read at the call, as GL reads
-//! them, and become immediate geometry.
+//! them, and become immediate geometry. When a buffer's contents change,
+//! the draw is recorded again; if only its vertices moved (the same draw
+//! shape — the cache key without the array buffers' generations — and the
+//! same triangles) the new recording refits the previous one's BVHs
+//! instead of building its own ([`Recorded::moved`]).
 
 use std::{collections::HashMap, sync::Arc};
 
 use glam::{Vec3, Vec4};
 
-use super::{Command, Recorder};
+use super::{Command, Recorded, Recorder};
 use crate::gl;
 
 /// `GL_ARRAY_BUFFER`.
@@ -99,6 +103,15 @@ pub(crate) struct DrawKey {
     arrays: [Option<(ArrayPointer, u64)>; 3],
     /// The element buffer and its generation (`glDrawElements`).
     elements: Option<(u32, u64)>,
+}
+
+impl DrawKey {
+    /// The draw's shape: the key with the array buffers' generations
+    /// left out (0). Two draws of one shape differ only in their vertex
+    /// data, so the later one may refit the earlier one's BVHs.
+    fn shape(&self) -> Self {
+        Self { arrays: self.arrays.map(|a| a.map(|(p, _)| (p, 0))), ..self.clone() }
+    }
 }
 
 /// Where a draw's vertex indices come from.
@@ -448,12 +461,33 @@ impl Recorder {
                 return;
             }
             // SAFETY: passed on from the caller.
-            let g = self.captured(mv, to_local, |r| unsafe { r.emit(mode, idx) });
+            let geometry = self.capture_geometry(mv, to_local, |r| unsafe { r.emit(mode, idx) });
+            // The same draw before its buffers changed: its BVHs are
+            // refitted if the triangles are the same.
+            let shape = key.shape();
+            let previous = self.draw_shapes.get(&shape).and_then(|k| self.draw_cache.get(k));
+            let g = Arc::new(match previous {
+                Some((_, p)) => Recorded::moved(geometry, p),
+                None => Recorded::new(geometry),
+            });
+            if g.is_refit() {
+                self.counters.draw_refits += 1;
+            } else {
+                self.counters.draw_builds += 1;
+            }
             if self.draw_cache.len() >= MAX_CACHED_DRAWS {
                 self.draw_cache.clear();
+                self.draw_shapes.clear();
+            }
+            // The shape's previous entry can never be hit again (its
+            // buffers' generations are gone): dropped, so a buffer
+            // updated every frame keeps one entry, not one per frame.
+            if let Some(old) = self.draw_shapes.insert(shape, key.clone())
+                && old != key
+            {
+                self.draw_cache.remove(&old);
             }
             self.draw_cache.insert(key, (inherited, Arc::clone(&g)));
-            self.counters.draw_builds += 1;
             self.instance(g, mv);
         } else {
             if self.compiling.is_none() {

@@ -16,26 +16,20 @@
 //! The recorder is plain Rust, with no GL in it: the interposer feeds it
 //! the calls it forwards, and the tests feed it directly.
 
-use std::{
-    collections::HashMap,
-    sync::{Arc, OnceLock},
-};
+use std::{collections::HashMap, sync::Arc};
 
 use glam::{Mat3, Mat4, Vec3, Vec4};
-use rt_accel::{
-    BuildError, BuildParams, Object, Scene, build_capsules, build_spheres, build_triangles,
-};
-use rt_core::{
-    Aabb, Hit, Ray, SceneQuery,
-    intersect::{Capsule, Sphere},
-};
+use rt_accel::{BuildError, BuildParams, Scene, build_capsules, build_spheres, build_triangles};
+use rt_core::intersect::{Capsule, Sphere};
 
 use crate::gl;
 
 pub mod arrays;
+mod recorded;
 
 pub use arrays::ArrayPointer;
 use arrays::{ArrayState, DrawKey};
+pub use recorded::Recorded;
 
 /// One recorded call, as display lists store them.
 #[derive(Clone, Debug, PartialEq)]
@@ -270,23 +264,26 @@ impl Geometry {
     /// [`BuildError`] if a primitive is not finite.
     pub fn build(&self) -> Result<Scene, BuildError> {
         let params = BuildParams::fast();
-        let spheres: Vec<Sphere> = self
-            .spheres
-            .iter()
-            .map(|&(v, r, _)| Sphere::new(self.positions[v as usize], r))
-            .collect();
-        let tubes: Vec<Capsule> = self
-            .tubes
+        Ok(Scene {
+            triangles: build_triangles(&self.positions, &self.triangles, &params)?,
+            spheres: build_spheres(&self.sphere_shapes(), &params)?,
+            capsules: build_capsules(&self.tube_shapes(), &params)?,
+        })
+    }
+
+    /// The points as spheres, in the order of [`Self::spheres`].
+    fn sphere_shapes(&self) -> Vec<Sphere> {
+        self.spheres.iter().map(|&(v, r, _)| Sphere::new(self.positions[v as usize], r)).collect()
+    }
+
+    /// The line segments as capsules, in the order of [`Self::tubes`].
+    fn tube_shapes(&self) -> Vec<Capsule> {
+        self.tubes
             .iter()
             .map(|&([a, b], r, _)| {
                 Capsule::new(self.positions[a as usize], self.positions[b as usize], r)
             })
-            .collect();
-        Ok(Scene {
-            triangles: build_triangles(&self.positions, &self.triangles, &params)?,
-            spheres: build_spheres(&spheres, &params)?,
-            capsules: build_capsules(&tubes, &params)?,
-        })
+            .collect()
     }
 
     fn shading_index(&mut self, s: Shading) -> u32 {
@@ -303,50 +300,6 @@ impl Geometry {
 pub fn normal_matrix(m: &Mat4) -> Mat3 {
     let a = Mat3::from_mat4(*m);
     if a.determinant() == 0.0 { Mat3::IDENTITY } else { a.inverse().transpose() }
-}
-
-/// Geometry recorded once (a display list or a buffer draw) and its
-/// BVHs, built the first time a frame is traced and kept while the
-/// recording is.
-#[derive(Debug)]
-pub struct Recorded {
-    /// The geometry, in its entry space.
-    pub geometry: Geometry,
-    scene: OnceLock<Result<Scene, BuildError>>,
-}
-
-impl Recorded {
-    /// A recording whose BVHs are not built yet.
-    #[must_use]
-    pub fn new(geometry: Geometry) -> Self {
-        Self { geometry, scene: OnceLock::new() }
-    }
-
-    /// The BVHs over the geometry, built on first use.
-    ///
-    /// # Errors
-    /// The build's error (a primitive that is not finite).
-    pub fn scene(&self) -> Result<&Scene, BuildError> {
-        self.scene.get_or_init(|| self.geometry.build()).as_ref().map_err(Clone::clone)
-    }
-
-    /// Whether the BVHs have been built.
-    #[must_use]
-    pub fn is_built(&self) -> bool {
-        self.scene.get().is_some()
-    }
-}
-
-impl Object for Recorded {
-    fn bounds(&self) -> Aabb {
-        self.scene().map_or(Aabb::EMPTY, Object::bounds)
-    }
-    fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
-        SceneQuery::closest_hit(self.scene().ok()?, ray)
-    }
-    fn occluded(&self, ray: &Ray) -> bool {
-        self.scene().is_ok_and(|s| SceneQuery::occluded(s, ray))
-    }
 }
 
 /// One frame's draws: immediate geometry in eye space and instances of
@@ -390,10 +343,16 @@ pub struct Counters {
     /// geometry: lists that load matrices, draw points or lines, or are
     /// called inside `glBegin`).
     pub list_inline: u64,
-    /// Array draws from buffer objects recorded into a new cache entry.
+    /// Array draws from buffer objects recorded into a new cache entry
+    /// whose BVHs are built.
     pub draw_builds: u64,
     /// Array draws from buffer objects answered from the cache.
     pub draw_reuses: u64,
+    /// Array draws from buffer objects recorded into a new cache entry
+    /// whose BVHs are refitted from the previous entry of the same draw
+    /// (its buffers' contents changed, its triangles did not) rather than
+    /// built: not also counted in `draw_builds`.
+    pub draw_refits: u64,
     /// Array draws from client memory (or with points and lines),
     /// recorded as immediate geometry.
     pub draw_inline: u64,
@@ -578,6 +537,9 @@ pub struct Recorder {
     /// Vertex arrays and buffer objects.
     arrays: ArrayState,
     draw_cache: HashMap<DrawKey, (Inherited, Arc<Recorded>)>,
+    /// Per draw shape ([`DrawKey::shape`]): the key of its latest entry in
+    /// `draw_cache`, whose BVHs the next recording of the shape refits.
+    draw_shapes: HashMap<DrawKey, DrawKey>,
     /// What has been done so far.
     pub counters: Counters,
 }
@@ -623,6 +585,7 @@ impl Recorder {
             frame: Frame::default(),
             arrays: ArrayState::default(),
             draw_cache: HashMap::new(),
+            draw_shapes: HashMap::new(),
             counters: Counters::default(),
         }
     }
@@ -1046,13 +1009,24 @@ impl Recorder {
     /// Runs `f` with its geometry recorded in the entry space of the
     /// modelview `mv` (`to_local` its inverse).
     fn captured(&mut self, mv: Mat4, to_local: Mat4, f: impl FnOnce(&mut Self)) -> Arc<Recorded> {
+        Arc::new(Recorded::new(self.capture_geometry(mv, to_local, f)))
+    }
+
+    /// The geometry `f` draws, in the entry space of the modelview `mv`
+    /// (`to_local` its inverse).
+    fn capture_geometry(
+        &mut self,
+        mv: Mat4,
+        to_local: Mat4,
+        f: impl FnOnce(&mut Self),
+    ) -> Geometry {
         self.capture = Some(Capture {
             geometry: Geometry::default(),
             to_local,
             normal_to_local: Mat3::from_mat4(mv).transpose(),
         });
         f(self);
-        Arc::new(Recorded::new(self.capture.take().map(|c| c.geometry).unwrap_or_default()))
+        self.capture.take().map(|c| c.geometry).unwrap_or_default()
     }
 
     /// Adds an instance of cached geometry to the frame.
