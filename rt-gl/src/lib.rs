@@ -14,8 +14,10 @@
 //! ```
 //!
 //! - [`record`]: the recorder, a mirror of GL's fixed-function state that
-//!   turns draws into geometry; display lists are recorded once and
-//!   instanced on every call.
+//!   turns draws into geometry; display lists and buffer draws are
+//!   recorded once and instanced on every call, and a buffer draw whose
+//!   vertices change but whose triangles do not has its BVHs refitted,
+//!   not rebuilt ([`record::Recorded::moved`]).
 //! - [`render`]: the frame ray traced per pixel with GL's lighting
 //!   equation (`gl` mode) or with shadows, ambient occlusion and mirror
 //!   reflections too (`rt`).
@@ -28,7 +30,9 @@
 //! (reflections of the specular colour in `rt` mode), `RT_GL_THREADS=<n>`,
 //! `RT_GL_DUMP=<dir>` (each frame as `rt-NNNN.png`, counters in
 //! `counters.txt`), `RT_GL_DUMP_RASTER=1` (also what the real GL drew, as
-//! `raster-NNNN.png`), `RT_GL_STATS=1` (counters per frame on stderr).
+//! `raster-NNNN.png`), `RT_GL_STATS=1` (counters per frame on stderr:
+//! [`record::Counters`] — builds, refits and reuses of lists and buffer
+//! draws, instances, triangles, ignored calls).
 
 // A std-only library loaded into programs: the no_std import lints of the
 // workspace do not apply.
