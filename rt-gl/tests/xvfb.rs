@@ -168,6 +168,53 @@ fn test_program_frames_match_the_raster() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A waving grid whose vertices and normals the program rewrites every
+/// frame (`glBufferSubData`, and `glBufferData` every fourth frame) over
+/// a static element buffer, drawn twice per frame: built once, then
+/// refitted every frame (the second draw of a frame reused), and every
+/// frame's coverage agrees with Mesa's raster as the other scenes' does.
+#[test]
+#[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
+fn waving_vbo_is_refitted_every_frame() {
+    let dir = scratch("wave");
+    let exe = scenes_program(&dir);
+    let frames = 12;
+    let out = Command::new(tool("xvfb-run"))
+        .args(["-a", "-s", "-screen 0 640x480x24"])
+        .arg(&exe)
+        .args(["wave", &frames.to_string()])
+        .env("LD_PRELOAD", interposer())
+        .env("RT_GL_DUMP", &dir)
+        .env("RT_GL_DUMP_RASTER", "1")
+        .output()
+        .expect("run xvfb-run");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(stdout.contains(&format!("frames {frames}")), "{stdout}");
+    assert!(!stderr.contains("left as rasterized"), "{stderr}");
+    let bg = [26, 26, 38];
+    let mut previous: Option<Vec<u8>> = None;
+    for f in 0..frames {
+        let traced = dir.join(format!("rt-{f:04}.png"));
+        let (agree, diff) = compare(&dir.join(format!("raster-{f:04}.png")), &traced, bg);
+        assert!(agree >= 0.99, "frame {f}: coverage agrees on {:.2} %", 100.0 * agree);
+        assert!(diff <= 4.0, "frame {f}: mean colour difference {diff:.2}/255");
+        // The grid moves: a refit that kept the old vertices would trace
+        // the same picture again.
+        let (_, _, rgba) = read_png(&traced);
+        assert_ne!(previous.as_ref(), Some(&rgba), "frame {f} traced as frame {}", f - 1);
+        previous = Some(rgba);
+    }
+    let c = counters(&dir);
+    assert_eq!(c["frames"], frames as u64);
+    assert_eq!(c["draw_builds"], 1, "{c:?}");
+    assert_eq!(c["draw_refits"], frames as u64 - 1, "{c:?}");
+    assert_eq!(c["draw_reuses"], frames as u64, "{c:?}");
+    assert_eq!(c["draw_inline"], 0, "{c:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Debian's glxgears, unmodified, for ≥ 30 frames: coverage agrees with
 /// Mesa's raster on ≥ 99 % of every frame, and the three gears' display
 /// lists are built once and instanced on every frame after.

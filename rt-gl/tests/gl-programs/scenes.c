@@ -8,6 +8,10 @@
  *                       in a 512² window; prints "frame <i> <seconds>" per
  *                       frame (the frame time includes glFinish after the
  *                       swap)
+ *   scenes wave F       a waving grid, F frames: its vertices and normals
+ *                       rewritten every frame (glBufferSubData, and every
+ *                       fourth frame glBufferData) over a static element
+ *                       buffer, drawn twice per frame
  *
  * Build: cc -O2 -o scenes scenes.c -lGL -lX11 -lm
  */
@@ -140,8 +144,9 @@ static int grid(int nx, int ny, float **pos, float **nrm, unsigned **idx) {
     return nv;
 }
 
-/* The grid in three new buffer objects b: positions, normals, indices. */
-static void upload_grid(int nx, int ny, GLuint b[3], float **pos, float **nrm, unsigned **idx) {
+/* The grid in three new buffer objects b: positions, normals, indices;
+   returns the vertex count. */
+static int upload_grid(int nx, int ny, GLuint b[3], float **pos, float **nrm, unsigned **idx) {
     int nv = grid(nx, ny, pos, nrm, idx);
     glGenBuffers(3, b);
     glBindBuffer(GL_ARRAY_BUFFER, b[0]);
@@ -150,6 +155,7 @@ static void upload_grid(int nx, int ny, GLuint b[3], float **pos, float **nrm, u
     glBufferData(GL_ARRAY_BUFFER, sizeof(float) * 3 * nv, *nrm, GL_STATIC_DRAW);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, b[2]);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, sizeof(unsigned) * 6 * nx * ny, *idx, GL_STATIC_DRAW);
+    return nv;
 }
 
 static GLuint lists;
@@ -435,8 +441,74 @@ static double mesh_frames(int n, int frames) {
     return 0;
 }
 
+/* The grid's heights and normals at time `phase`: the same vertices in
+   x and y every frame, a travelling wave in z. */
+static void wave_grid(int nx, int ny, float phase, float *pos, float *nrm) {
+    for (int y = 0; y <= ny; y++)
+        for (int x = 0; x <= nx; x++) {
+            int v = y * (nx + 1) + x;
+            float u = 3.0f * x / nx - 1.5f, w = 3.0f * y / ny - 1.5f;
+            pos[3 * v] = u;
+            pos[3 * v + 1] = w;
+            pos[3 * v + 2] = 0.3f * sinf(3 * u + phase) * cosf(2 * w);
+            float dx = 0.9f * cosf(3 * u + phase) * cosf(2 * w);
+            float dy = -0.6f * sinf(3 * u + phase) * sinf(2 * w);
+            float l = sqrtf(dx * dx + dy * dy + 1);
+            nrm[3 * v] = -dx / l;
+            nrm[3 * v + 1] = -dy / l;
+            nrm[3 * v + 2] = 1 / l;
+        }
+}
+
+static void wave_frames(int frames) {
+    float *p, *nr;
+    unsigned *idx;
+    GLuint b[3];
+    int nx = 24, ny = 24, nv = upload_grid(nx, ny, b, &p, &nr, &idx);
+    GLsizeiptr bytes = sizeof(float) * 3 * nv;
+    for (int f = 0; f < frames; f++) {
+        wave_grid(nx, ny, 0.6f * f, p, nr);
+        glBindBuffer(GL_ARRAY_BUFFER, b[0]);
+        if (f % 4 == 3) {
+            glBufferData(GL_ARRAY_BUFFER, bytes, p, GL_DYNAMIC_DRAW);
+        } else {
+            /* In two pieces, as programs that update ranges do. */
+            glBufferSubData(GL_ARRAY_BUFFER, 0, bytes / 2, p);
+            glBufferSubData(GL_ARRAY_BUFFER, bytes / 2, bytes - bytes / 2, (char *)p + bytes / 2);
+        }
+        glBindBuffer(GL_ARRAY_BUFFER, b[1]);
+        glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, nr);
+        begin_frame();
+        perspective();
+        lights();
+        material(0.4f, 0.7f, 0.9f);
+        glEnableClientState(GL_VERTEX_ARRAY);
+        glEnableClientState(GL_NORMAL_ARRAY);
+        glBindBuffer(GL_ARRAY_BUFFER, b[0]);
+        glVertexPointer(3, GL_FLOAT, 0, 0);
+        glBindBuffer(GL_ARRAY_BUFFER, b[1]);
+        glNormalPointer(GL_FLOAT, 0, 0);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, b[2]);
+        for (int k = 0; k < 2; k++) {
+            glPushMatrix();
+            glTranslatef(-0.8f + 1.6f * k, 0.0f, 0.0f);
+            glRotatef(-60 + 20 * k, 1, 0, 0);
+            glScalef(0.45f, 0.45f, 0.45f);
+            glDrawElements(GL_TRIANGLES, 6 * nx * ny, GL_UNSIGNED_INT, 0);
+            glPopMatrix();
+        }
+        glBindBuffer(GL_ARRAY_BUFFER, 0);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
+        glDisableClientState(GL_VERTEX_ARRAY);
+        glDisableClientState(GL_NORMAL_ARRAY);
+        glXSwapBuffers(glXGetCurrentDisplay(), glXGetCurrentDrawable());
+    }
+    printf("frames %d\n", frames);
+}
+
 int main(int argc, char **argv) {
     int mesh = argc >= 4 && strcmp(argv[1], "mesh") == 0;
+    int wave = argc >= 3 && strcmp(argv[1], "wave") == 0;
     if (mesh) W = H = 512;
     Display *dpy = XOpenDisplay(NULL);
     if (!dpy) {
@@ -460,6 +532,8 @@ int main(int argc, char **argv) {
 
     if (mesh) {
         mesh_frames(atoi(argv[2]), atoi(argv[3]));
+    } else if (wave) {
+        wave_frames(atoi(argv[2]));
     } else {
         int frames = argc >= 2 ? atoi(argv[1]) : SCENES;
         setup();
