@@ -97,10 +97,11 @@ impl Config {
         options.shadows = flag("RT_GL_SHADOWS", true);
         if let Some(v) = var("RT_GL_AO") {
             match v.parse::<u32>() {
-                Ok(n) if n <= 1024 => options.ao_samples = n,
-                _ => {
-                    log_once("RT_GL_AO", &format!("RT_GL_AO={v}: expected 0..=1024 rays; using 8"))
-                }
+                Ok(n) if n <= render::MAX_AO_SAMPLES => options.ao_samples = n,
+                _ => log_once(
+                    "RT_GL_AO",
+                    &format!("RT_GL_AO={v}: expected 0..={} rays; using 8", render::MAX_AO_SAMPLES),
+                ),
             }
         }
         if let Some(v) = var("RT_GL_MIRROR") {

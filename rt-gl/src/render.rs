@@ -16,12 +16,12 @@ use std::sync::Arc;
 
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
-use rt_accel::{BuildError, InstanceError, Instances, Object, Scene};
+use rt_accel::{InstanceError, Instances, Object, Scene};
 use rt_core::{
     Hit, PrimKind, Ray, SceneQuery, camera::cosine_hemisphere, sampling, spawn_ray, spawn_ray_to,
 };
 
-use crate::record::{Frame, Geometry, Lighting, Recorded, Shading, normal_matrix};
+use crate::record::{Frame, Geometry, GeometryError, Lighting, Recorded, Shading, normal_matrix};
 
 /// How frames are shaded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -33,6 +33,13 @@ pub enum Mode {
     Rt,
 }
 
+/// Deepest reflection [`Options::bounces`] may ask for: reflections
+/// recurse on the tracing thread's stack.
+pub const MAX_BOUNCES: u32 = 16;
+/// Most ambient-occlusion rays per pixel [`Options::ao_samples`] may ask
+/// for.
+pub const MAX_AO_SAMPLES: u32 = 1024;
+
 /// Render settings (from the `RT_GL_*` environment variables).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Options {
@@ -40,15 +47,29 @@ pub struct Options {
     pub mode: Mode,
     /// Shadow rays toward every enabled light (`Rt` mode).
     pub shadows: bool,
-    /// Ambient-occlusion rays per pixel (`Rt` mode; 0: off).
+    /// Ambient-occlusion rays per pixel (`Rt` mode; 0: off), at most
+    /// [`MAX_AO_SAMPLES`].
     pub ao_samples: u32,
-    /// Longest AO ray, as a fraction of the scene's diagonal.
+    /// Longest AO ray, as a fraction of the scene's diagonal (finite,
+    /// ≥ 0).
     pub ao_distance: f32,
     /// Mirror reflections (`Rt` mode): a surface reflects its specular
-    /// colour times this (0: off), up to `bounces` deep.
+    /// colour times this (finite, ≥ 0; 0: off), up to `bounces` deep.
     pub mirror: f32,
-    /// Deepest reflection.
+    /// Deepest reflection, at most [`MAX_BOUNCES`].
     pub bounces: u32,
+}
+
+impl Options {
+    /// Whether every setting is in its documented range.
+    #[must_use]
+    pub fn is_valid(&self) -> bool {
+        let non_negative = |x: f32| x.is_finite() && x >= 0.0;
+        self.ao_samples <= MAX_AO_SAMPLES
+            && self.bounces <= MAX_BOUNCES
+            && non_negative(self.ao_distance)
+            && non_negative(self.mirror)
+    }
 }
 
 impl Default for Options {
@@ -112,32 +133,49 @@ impl Image {
 /// Why a frame could not be ray traced (the program's own image stays).
 #[derive(Clone, Debug, PartialEq)]
 pub enum RenderError {
-    /// The BVH could not be built (e.g. a vertex overflowed to infinity).
-    Build(BuildError),
+    /// The frame's immediate geometry or a recording's cannot be traced:
+    /// malformed (a hand-made [`Geometry`] with an index out of range or
+    /// an array of the wrong length), or its BVH could not be built
+    /// (e.g. a vertex overflowed to infinity).
+    Geometry(GeometryError),
     /// The projection matrix is singular or not finite.
     BadProjection,
     /// The viewport is empty or larger than 16384 × 16384.
     BadViewport,
     /// A recorded modelview cannot place an instance.
     Instance(InstanceError),
+    /// A setting is out of its range ([`Options::is_valid`]).
+    BadOptions,
 }
 
 impl core::fmt::Display for RenderError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
-            Self::Build(e) => write!(f, "building the frame's BVH: {e}"),
+            Self::Geometry(e) => write!(f, "the frame's geometry: {e}"),
             Self::BadProjection => write!(f, "projection matrix is singular or not finite"),
             Self::BadViewport => write!(f, "viewport empty or larger than 16384 × 16384"),
             Self::Instance(e) => write!(f, "placing a recorded list: {e}"),
+            Self::BadOptions => write!(
+                f,
+                "render options out of range (bounces ≤ {MAX_BOUNCES}, AO rays ≤ {MAX_AO_SAMPLES}, AO distance and mirror finite and ≥ 0)"
+            ),
         }
     }
 }
 
-impl core::error::Error for RenderError {}
+impl core::error::Error for RenderError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            Self::Geometry(e) => Some(e),
+            Self::Instance(e) => Some(e),
+            _ => None,
+        }
+    }
+}
 
-impl From<BuildError> for RenderError {
-    fn from(e: BuildError) -> Self {
-        Self::Build(e)
+impl From<GeometryError> for RenderError {
+    fn from(e: GeometryError) -> Self {
+        Self::Geometry(e)
     }
 }
 
@@ -165,7 +203,8 @@ impl FrameScene {
     /// frame's instances (building any recording's BVHs not built yet).
     ///
     /// # Errors
-    /// [`RenderError::Build`] if a primitive is not finite;
+    /// [`RenderError::Geometry`] if a geometry is malformed
+    /// ([`Geometry::check`]) or a primitive is not finite;
     /// [`RenderError::Instance`] if a transform is singular.
     pub fn build(frame: Frame) -> Result<Self, RenderError> {
         let scene = frame.immediate.build()?;
@@ -207,7 +246,8 @@ impl FrameScene {
     /// `background` where nothing is hit.
     ///
     /// # Errors
-    /// [`RenderError::BadProjection`] or [`RenderError::BadViewport`].
+    /// [`RenderError::BadProjection`], [`RenderError::BadViewport`] or
+    /// [`RenderError::BadOptions`].
     pub fn render(
         &self,
         lighting: &Lighting,
@@ -219,6 +259,9 @@ impl FrameScene {
     ) -> Result<Image, RenderError> {
         if width == 0 || height == 0 || width > 16384 || height > 16384 {
             return Err(RenderError::BadViewport);
+        }
+        if !opts.is_valid() {
+            return Err(RenderError::BadOptions);
         }
         let inv = projection.inverse();
         if projection.determinant() == 0.0 || !inv.is_finite() {
@@ -257,7 +300,7 @@ impl FrameScene {
             Source::Instance(i) => {
                 // `i` came from this frame's own instances.
                 let obj = self.instances.object_of(i).unwrap_or(0);
-                (&self.instances.objects()[obj as usize].geometry, self.normal[i as usize])
+                (self.instances.objects()[obj as usize].geometry(), self.normal[i as usize])
             }
         };
         let (sh, col, n) = Self::surface_in(g, hit);
@@ -266,6 +309,9 @@ impl FrameScene {
         (sh, col, n)
     }
 
+    /// Indexes freely: every geometry of the frame passed
+    /// [`Geometry::check`] when its BVHs were built, and a hit's `prim`
+    /// comes from those BVHs.
     fn surface_in(g: &Geometry, hit: &Hit) -> (Shading, Vec4, Vec3) {
         let p = hit.prim as usize;
         match hit.kind {

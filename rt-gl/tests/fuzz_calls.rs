@@ -6,8 +6,8 @@ use proptest::prelude::*;
 use rt_core::glam::{Mat4, Vec3, Vec4};
 use rt_gl::{
     gl,
-    record::{Command, Recorder, arrays},
-    render::{FrameScene, Mode, Options},
+    record::{Command, GeometryError, Recorder, arrays},
+    render::{FrameScene, Mode, Options, RenderError},
 };
 
 /// Floats including the awkward ones.
@@ -101,11 +101,27 @@ fn step() -> impl Strategy<Value = Step> {
 
 fn trace(r: &Recorder, mode: Mode) {
     let frame = r.frame().clone();
+    // What the recorder makes is always well formed.
+    assert_eq!(frame.immediate.check(), Ok(()));
+    for (rec, _) in &frame.instances {
+        assert_eq!(rec.geometry().check(), Ok(()));
+    }
     // Building may refuse non-finite geometry; rendering may refuse the
     // view: both are errors, not panics.
-    if let Ok(scene) = FrameScene::build(frame) {
-        let opts = Options { mode, ao_samples: 2, ..Options::default() };
-        let _ = scene.render(&r.lighting, r.projection(), 12, 9, Vec4::ZERO, &opts);
+    match FrameScene::build(frame) {
+        Ok(scene) => {
+            let opts = Options { mode, ao_samples: 2, ..Options::default() };
+            let _ = scene.render(&r.lighting, r.projection(), 12, 9, Vec4::ZERO, &opts);
+        }
+        Err(e) => {
+            assert!(
+                matches!(
+                    e,
+                    RenderError::Geometry(GeometryError::Build(_)) | RenderError::Instance(_)
+                ),
+                "{e}"
+            );
+        }
     }
 }
 

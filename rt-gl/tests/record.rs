@@ -174,7 +174,7 @@ fn lists_are_recorded_once_and_instanced() {
                 draw(&mut direct, gl::TRIANGLES, &[Vec3::ZERO, Vec3::Y, Vec3::Z]);
             }
             let want = direct.end_frame().immediate;
-            let got = f.flatten();
+            let got = f.flatten().expect("recorded geometry is well formed");
             assert_eq!(got.triangles, want.triangles);
             for (a, b) in got.positions.iter().zip(&want.positions) {
                 assert!((*a - *b).length() < 1e-5, "{a} vs {b}");
@@ -215,12 +215,18 @@ fn buffer_draws_are_cached_until_the_buffer_changes() {
     assert_eq!((r.counters.draw_builds, r.counters.draw_reuses), (1, 1));
     let f = r.end_frame();
     assert_eq!(f.instances.len(), 2);
-    assert_eq!(f.flatten().positions[2], Vec3::new(0.0, 1.0, -3.0));
+    assert_eq!(
+        f.flatten().expect("recorded geometry is well formed").positions[2],
+        Vec3::new(0.0, 1.0, -3.0)
+    );
     r.buffer_sub_data(arrays::ARRAY_BUFFER, 28, &2.0f32.to_ne_bytes());
     // SAFETY: as above.
     unsafe { r.draw_arrays(gl::TRIANGLES, 0, 3) };
     assert_eq!(r.counters.draw_builds, 2);
-    assert_eq!(r.end_frame().flatten().positions[2], Vec3::new(0.0, 2.0, -3.0));
+    assert_eq!(
+        r.end_frame().flatten().expect("recorded geometry is well formed").positions[2],
+        Vec3::new(0.0, 2.0, -3.0)
+    );
     // Indices past the buffer, a negative count and an absurd one are
     // ignored, not read.
     let before = r.counters.ignored;
@@ -441,7 +447,7 @@ fn mutually_recursive_lists_stop_at_the_budget() {
     r.set_list_budget(10_000);
     r.command(Command::CallList(1));
     assert!(r.counters.ignored > 0);
-    let tris = r.end_frame().flatten().triangles.len();
+    let tris = r.end_frame().flatten().expect("recorded geometry is well formed").triangles.len();
     assert!(tris > 100 && tris < 10_000, "{tris} triangles");
     // The next call gets a fresh budget.
     r.command(Command::CallList(2));

@@ -104,7 +104,7 @@ fn rays() -> Vec<Ray> {
 /// geometry; returns how many rays hit.
 fn assert_same_as_a_build(rec: &Recorded) -> usize {
     let scene = rec.scene().expect("finite geometry");
-    let fresh = rec.geometry.build().expect("finite geometry");
+    let fresh = rec.geometry().build().expect("finite geometry");
     assert_eq!(rt_accel::Object::bounds(scene), rt_accel::Object::bounds(&fresh));
     let mut hits = 0;
     for ray in rays() {
@@ -226,7 +226,7 @@ fn changed_triangles_are_built_not_refit() {
     move_vertices(&mut r, &p);
     let rec = draw_elements(&mut r, flipped.len());
     check(&r, &rec, &mut builds, 2);
-    assert!(rec.geometry.triangles.len() < flipped.len() / 3);
+    assert!(rec.geometry().triangles.len() < flipped.len() / 3);
 }
 
 /// A triangle degenerate when the previous entry was built is left out
@@ -305,6 +305,6 @@ fn a_new_colour_over_the_same_buffers_refits() {
     r.command(Command::Color(blue));
     let rec = draw_elements(&mut r, idx.len());
     assert_eq!((r.counters.draw_builds, r.counters.draw_refits), (1, 1));
-    assert!(rec.geometry.colors.iter().all(|&c| c == blue));
+    assert!(rec.geometry().colors.iter().all(|&c| c == blue));
     assert_same_as_a_build(&rec);
 }

@@ -25,10 +25,12 @@ use rt_core::intersect::{Capsule, Sphere};
 use crate::gl;
 
 pub mod arrays;
+mod check;
 mod recorded;
 
 pub use arrays::ArrayPointer;
 use arrays::{ArrayState, DrawKey};
+pub use check::{GeometryError, Primitive};
 pub use recorded::Recorded;
 
 /// One recorded call, as display lists store them.
@@ -209,18 +211,22 @@ fn apply_color_material(m: &mut MaterialState, mode: u32, c: Vec4) {
 }
 
 /// Recorded geometry in one space, with what shading needs.
+///
+/// The fields are public, and nothing stops a hand-made geometry from
+/// breaking the rules below; [`Geometry::check`] tells, and building or
+/// tracing such a geometry is a [`GeometryError`], never a panic.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Geometry {
     /// Vertex positions.
     pub positions: Vec<Vec3>,
-    /// Vertex normals (unnormalised, as transformed).
+    /// Vertex normals (unnormalised, as transformed), one per position.
     pub normals: Vec<Vec3>,
-    /// Vertex colours.
+    /// Vertex colours, one per position.
     pub colors: Vec<Vec4>,
     /// Triangles (vertex indices, counter-clockwise as drawn).
     pub triangles: Vec<[u32; 3]>,
-    /// Per triangle: its shading (index into `shadings`) and provoking
-    /// vertex (for flat shading).
+    /// Per triangle (one entry each): its shading (index into
+    /// `shadings`) and provoking vertex (for flat shading).
     pub triangle_info: Vec<(u32, u32)>,
     /// Points drawn as spheres: vertex, radius, shading.
     pub spheres: Vec<(u32, f32, u32)>,
@@ -239,30 +245,54 @@ impl Geometry {
 
     /// Appends `other` transformed by `m` (positions) and `m`'s normal
     /// matrix (normals).
-    pub fn append_transformed(&mut self, other: &Self, m: &Mat4) {
-        let base = self.positions.len() as u32;
-        let sbase = self.shadings.len() as u32;
+    ///
+    /// # Errors
+    /// What [`Geometry::check`] finds in `self` or in `other`; nothing is
+    /// appended then (an index out of range, offset, could name a vertex
+    /// of the other geometry and pass unnoticed).
+    pub fn append_transformed(&mut self, other: &Self, m: &Mat4) -> Result<(), GeometryError> {
+        self.check()?;
+        other.check()?;
+        self.append_checked(other, m);
+        Ok(())
+    }
+
+    /// [`Geometry::append_transformed`] of two geometries that have
+    /// passed [`Geometry::check`].
+    fn append_checked(&mut self, other: &Self, m: &Mat4) {
+        // Saturating: past 2³² vertices an index cannot be offset (nor
+        // made), and must not wrap onto a vertex that exists.
+        let base = u32::try_from(self.positions.len()).unwrap_or(u32::MAX);
+        let sbase = u32::try_from(self.shadings.len()).unwrap_or(u32::MAX);
+        let v = |i: u32| i.saturating_add(base);
+        let s = |i: u32| i.saturating_add(sbase);
         let nm = normal_matrix(m);
         // Radii scale with the transform's mean scale.
         let scale = Mat3::from_mat4(*m).determinant().abs().cbrt();
         self.positions.extend(other.positions.iter().map(|&p| m.transform_point3(p)));
         self.normals.extend(other.normals.iter().map(|&n| nm * n));
         self.colors.extend_from_slice(&other.colors);
-        self.triangles.extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
-        self.triangle_info.extend(other.triangle_info.iter().map(|&(s, p)| (s + sbase, p + base)));
-        self.spheres
-            .extend(other.spheres.iter().map(|&(v, r, s)| (v + base, r * scale, s + sbase)));
-        self.tubes.extend(
-            other.tubes.iter().map(|&(v, r, s)| (v.map(|i| i + base), r * scale, s + sbase)),
-        );
+        self.triangles.extend(other.triangles.iter().map(|t| t.map(v)));
+        self.triangle_info.extend(other.triangle_info.iter().map(|&(k, p)| (s(k), v(p))));
+        self.spheres.extend(other.spheres.iter().map(|&(i, r, k)| (v(i), r * scale, s(k))));
+        self.tubes.extend(other.tubes.iter().map(|&(e, r, k)| (e.map(v), r * scale, s(k))));
         self.shadings.extend_from_slice(&other.shadings);
     }
 
-    /// BVHs over the triangles, spheres and tubes.
+    /// BVHs over the triangles, spheres and tubes, once the geometry has
+    /// passed [`Geometry::check`].
     ///
     /// # Errors
-    /// [`BuildError`] if a primitive is not finite.
-    pub fn build(&self) -> Result<Scene, BuildError> {
+    /// What [`Geometry::check`] finds, or [`GeometryError::Build`] if a
+    /// primitive is not finite (or a radius not positive).
+    pub fn build(&self) -> Result<Scene, GeometryError> {
+        self.check()?;
+        Ok(self.build_checked()?)
+    }
+
+    /// [`Geometry::build`] for a geometry that has passed
+    /// [`Geometry::check`].
+    fn build_checked(&self) -> Result<Scene, BuildError> {
         let params = BuildParams::fast();
         Ok(Scene {
             triangles: build_triangles(&self.positions, &self.triangles, &params)?,
@@ -272,11 +302,17 @@ impl Geometry {
     }
 
     /// The points as spheres, in the order of [`Self::spheres`].
+    ///
+    /// # Panics
+    /// On a geometry that has not passed [`Geometry::check`].
     fn sphere_shapes(&self) -> Vec<Sphere> {
         self.spheres.iter().map(|&(v, r, _)| Sphere::new(self.positions[v as usize], r)).collect()
     }
 
     /// The line segments as capsules, in the order of [`Self::tubes`].
+    ///
+    /// # Panics
+    /// On a geometry that has not passed [`Geometry::check`].
     fn tube_shapes(&self) -> Vec<Capsule> {
         self.tubes
             .iter()
@@ -316,17 +352,22 @@ impl Frame {
     /// Whether nothing was drawn.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.immediate.is_empty() && self.instances.iter().all(|(r, _)| r.geometry.is_empty())
+        self.immediate.is_empty() && self.instances.iter().all(|(r, _)| r.geometry().is_empty())
     }
 
     /// Everything in eye space, in one piece.
-    #[must_use]
-    pub fn flatten(&self) -> Geometry {
+    ///
+    /// # Errors
+    /// What [`Geometry::check`] finds in the immediate geometry or in a
+    /// recording's.
+    pub fn flatten(&self) -> Result<Geometry, GeometryError> {
+        self.immediate.check()?;
         let mut g = self.immediate.clone();
         for (inst, m) in &self.instances {
-            g.append_transformed(&inst.geometry, m);
+            inst.geometry().check()?;
+            g.append_checked(inst.geometry(), m);
         }
-        g
+        Ok(g)
     }
 }
 
@@ -620,7 +661,7 @@ impl Recorder {
         self.counters.frames += 1;
         self.counters.instances = self.frame.instances.len() as u64;
         self.counters.triangles = (self.frame.immediate.triangles.len()
-            + self.frame.instances.iter().map(|(r, _)| r.geometry.triangles.len()).sum::<usize>())
+            + self.frame.instances.iter().map(|(r, _)| r.geometry().triangles.len()).sum::<usize>())
             as u64;
         core::mem::take(&mut self.frame)
     }
@@ -684,9 +725,17 @@ impl Recorder {
             self.counters.ignored += 1;
             return;
         }
-        for id in first..first.saturating_add(range as u32) {
-            self.lists.remove(&id);
-            self.cache.remove(&id);
+        let ids = first..first.saturating_add(range as u32);
+        // Whichever is shorter: the range (one list at a time) or the
+        // lists (`glDeleteLists(1, INT_MAX)` must not walk 2³¹ ids).
+        if ids.len() <= self.lists.len() {
+            for id in ids {
+                self.lists.remove(&id);
+                self.cache.remove(&id);
+            }
+        } else {
+            self.lists.retain(|id, _| !ids.contains(id));
+            self.cache.retain(|id, _| !ids.contains(id));
         }
         self.generation += 1;
     }
@@ -1031,7 +1080,7 @@ impl Recorder {
 
     /// Adds an instance of cached geometry to the frame.
     fn instance(&mut self, geometry: Arc<Recorded>, mv: Mat4) {
-        if !geometry.geometry.is_empty() && self.state_only == 0 {
+        if !geometry.geometry().is_empty() && self.state_only == 0 {
             self.frame.instances.push((geometry, mv));
         }
     }

@@ -3,10 +3,10 @@
 
 use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 
-use rt_accel::{BuildError, Object, Scene};
+use rt_accel::{Object, Scene};
 use rt_core::{Aabb, Hit, Ray, SceneQuery, intersect::is_degenerate_triangle};
 
-use super::Geometry;
+use super::{Geometry, GeometryError};
 
 /// Geometry recorded once (a display list or a buffer draw) and its
 /// BVHs, made the first time a frame is traced and kept while the
@@ -18,11 +18,14 @@ use super::Geometry;
 /// boxes, which answers every ray exactly as a fresh build would (it may
 /// only be slower to traverse once vertices have moved far from where
 /// the tree was built).
+///
+/// The geometry cannot be changed once recorded ([`Recorded::geometry`]
+/// reads it): the BVHs and the shading of their hits must agree.
 #[derive(Debug)]
 pub struct Recorded {
     /// The geometry, in its entry space.
-    pub geometry: Geometry,
-    scene: OnceLock<Result<Scene, BuildError>>,
+    geometry: Geometry,
+    scene: OnceLock<Result<Scene, GeometryError>>,
     /// A built recording whose BVHs are refitted for this one, taken out
     /// at first use. Only built recordings go here, and a built one has
     /// already taken out its own source: no chain of recordings is kept
@@ -63,26 +66,35 @@ impl Recorded {
         Self { geometry, scene: OnceLock::new(), refit_from: Mutex::new(source), refit }
     }
 
+    /// The geometry, in its entry space.
+    #[must_use]
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+
     /// The BVHs over the geometry, built (or refitted) on first use.
     ///
     /// # Errors
-    /// The build's error (a primitive that is not finite).
-    pub fn scene(&self) -> Result<&Scene, BuildError> {
+    /// As [`Geometry::build`]: a malformed geometry (see
+    /// [`Geometry::check`]) or a primitive that is not finite.
+    pub fn scene(&self) -> Result<&Scene, GeometryError> {
         self.scene
             .get_or_init(|| {
                 let source = self.refit_from.lock().unwrap_or_else(PoisonError::into_inner).take();
+                // Checked before anything indexes it, refit or build.
+                self.geometry.check()?;
                 // A refit that fails (only a vertex that is not finite
                 // can make it) falls back to the build, which reports it.
                 match source.and_then(|s| self.refitted(&s)) {
                     Some(scene) => Ok(scene),
-                    None => self.geometry.build(),
+                    None => Ok(self.geometry.build_checked()?),
                 }
             })
             .as_ref()
             .map_err(Clone::clone)
     }
 
-    /// `source`'s BVHs moved to this recording's vertices.
+    /// `source`'s BVHs moved to this recording's vertices (checked).
     fn refitted(&self, source: &Self) -> Option<Scene> {
         let g = &self.geometry;
         let mut scene = source.scene.get()?.as_ref().ok()?.clone();
