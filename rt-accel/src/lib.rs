@@ -72,6 +72,7 @@ mod refit;
 #[cfg(feature = "alloc")]
 mod scene;
 mod simd;
+mod stream;
 mod traverse;
 mod tri_packet;
 
@@ -94,6 +95,7 @@ pub use prim::{BestHit, CapsuleItem, Primitive, SphereItem};
 pub use ray_ctx::RayCtx;
 #[cfg(feature = "alloc")]
 pub use scene::Scene;
+pub use stream::STREAM;
 pub use traverse::{BvhRef, MAX_DEPTH, STACK_SIZE, TraversalStack, TraversalStats};
 pub use tri_packet::TriPacket;
 

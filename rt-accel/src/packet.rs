@@ -370,13 +370,13 @@ impl<P: Primitive> BvhRef<'_, P> {
                     let r = bits.trailing_zeros() as usize;
                     bits &= bits - 1;
                     if let Some(ctx) = &l.ctx[r] {
-                        for (k, item) in self.items[first..first + count].iter().enumerate() {
+                        for (k, item) in self.leaf(first, count).iter().enumerate() {
                             item.closest((first + k) as u32, ctx, &mut best[r]);
                         }
                     }
                 }
             } else {
-                let node = &self.nodes[cur.index()];
+                let node = self.node(cur);
                 let bound: [f32; PACKET] = core::array::from_fn(|r| widen_far(best[r].t));
                 let (k, refs, masks, ts) = hit_children::<AVX>(node, l, rays, &bound);
                 if k > 0 {
@@ -448,7 +448,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                     bits &= bits - 1;
                     if let Some(ctx) = &l.ctx[r] {
                         let t_max = ctx.ray.t_max;
-                        if self.items[first..first + count].iter().any(|it| it.any(ctx, t_max)) {
+                        if self.leaf(first, count).iter().any(|it| it.any(ctx, t_max)) {
                             done |= 1 << r;
                         }
                     }
@@ -457,7 +457,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                     return done;
                 }
             } else {
-                let node = &self.nodes[cur.index()];
+                let node = self.node(cur);
                 let (k, refs, masks, ts) = hit_children::<AVX>(node, l, rays, &bound);
                 for a in 0..k {
                     stack.push(refs[a], masks[a], ts[a]);

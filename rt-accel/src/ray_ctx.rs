@@ -101,6 +101,15 @@ impl RayCtx {
         t0 <= t1
     }
 
+    /// The near and far plane rows of `bounds` (a node's) for axis `a`.
+    #[inline(always)]
+    pub(crate) fn planes<'b, T>(&self, bounds: &'b [T; 6], a: usize) -> (&'b T, &'b T) {
+        debug_assert!(self.near[a] < 6 && self.far[a] < 6);
+        // SAFETY: `RayCtx::new`, the only constructor, sets every `near`
+        // and `far` entry to `2·axis` or `2·axis + 1` with `axis < 3`.
+        unsafe { (bounds.get_unchecked(self.near[a]), bounds.get_unchecked(self.far[a])) }
+    }
+
     /// The ray these constants were made for.
     #[inline]
     #[must_use]

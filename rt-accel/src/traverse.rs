@@ -214,41 +214,78 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         start: ChildRef,
         stack: &mut TraversalStack,
     ) -> bool {
+        let mut walk = Walk { cur: start, sp: 0, best: BestHit::new(ctx.ray.t_max) };
+        loop {
+            match self.occluded_step::<AVX>(ctx, &mut walk, stack) {
+                Step::Go => {}
+                Step::Hit => return true,
+                Step::Done => return false,
+            }
+        }
+    }
+
+    /// One step of an occlusion traversal: visits `walk.cur` and pops the
+    /// next subtree (`walk.best` is not used).
+    #[inline(always)]
+    pub(crate) fn occluded_step<const AVX: bool>(
+        &self,
+        ctx: &RayCtx,
+        walk: &mut Walk,
+        stack: &mut TraversalStack,
+    ) -> Step {
         let t_max = ctx.ray.t_max;
         let stack = &mut stack.refs;
-        let mut sp = 0;
-        let mut cur = start;
-        loop {
-            if cur.is_leaf() {
-                let (first, count) = cur.leaf_range();
-                for item in &self.items[first..first + count] {
-                    if item.any(ctx, t_max) {
-                        return true;
-                    }
-                }
-            } else {
-                let node = &self.nodes[cur.index()];
-                // Widened as in `closest_kernel`: a box entered at a rounded
-                // distance just past `t_max` may hold a hit at exactly
-                // `t_max` (found by the `bvh` fuzz target with
-                // `t_min = t_max`).
-                let (mask, _) = box_test::<AVX>(node, ctx, widen_far(t_max));
-                // Empty slots are never entered (see `closest_from`).
-                let mut m = mask;
-                while m != 0 {
-                    let i = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    stack[sp].write(node.children[i]);
-                    sp += 1;
+        let Walk { cur, sp, .. } = walk;
+        if cur.is_leaf() {
+            let (first, count) = cur.leaf_range();
+            for item in self.leaf(first, count) {
+                if item.any(ctx, t_max) {
+                    return Step::Hit;
                 }
             }
-            if sp == 0 {
-                return false;
+        } else {
+            let node = self.node(*cur);
+            // Widened as in `closest_step`: a box entered at a rounded
+            // distance just past `t_max` may hold a hit at exactly
+            // `t_max` (found by the `bvh` fuzz target with
+            // `t_min = t_max`).
+            let (mask, _) = box_test::<AVX>(node, ctx, widen_far(t_max));
+            // Empty slots are never entered (see `closest_step`).
+            let mut m = mask;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                stack[*sp].write(node.children[i]);
+                *sp += 1;
             }
-            sp -= 1;
-            // SAFETY: entries below the pushes' count were written above.
-            cur = unsafe { stack[sp].assume_init() };
         }
+        if *sp == 0 {
+            return Step::Done;
+        }
+        *sp -= 1;
+        // SAFETY: entries below the pushes' count were written above.
+        *cur = unsafe { stack[*sp].assume_init() };
+        Step::Go
+    }
+
+    /// Inner node `c`.
+    #[inline(always)]
+    pub(crate) fn node(&self, c: ChildRef) -> &'a Node {
+        debug_assert!(c.index() < self.nodes.len());
+        // SAFETY: traversals only follow references stored in the tree
+        // (or the root of a non-empty tree), and every `BvhRef` was made
+        // by `Bvh::as_ref` or `BvhRef::from_bytes`, which prove that each
+        // inner reference names an existing node (`validate`).
+        unsafe { self.nodes.get_unchecked(c.index()) }
+    }
+
+    /// The items `first..first + count` of a leaf reference.
+    #[inline(always)]
+    pub(crate) fn leaf(&self, first: usize, count: usize) -> &'a [P] {
+        debug_assert!(first + count <= self.items.len());
+        // SAFETY: as in `node`: `validate` proves every leaf reference's
+        // range lies within the items.
+        unsafe { self.items.get_unchecked(first..first + count) }
     }
 
     #[inline(always)]
@@ -331,108 +368,136 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         &self,
         ctx: &RayCtx,
         start: ChildRef,
-        mut best: BestHit,
+        best: BestHit,
         stats: &mut TraversalStats,
         stack: &mut TraversalStack,
     ) -> BestHit {
+        let mut walk = Walk { cur: start, sp: 0, best };
+        while self.closest_step::<AVX>(ctx, &mut walk, stats, stack) {}
+        walk.best
+    }
+
+    /// One step of a closest-hit traversal: visits `walk.cur` (a node or
+    /// a leaf) and moves on to the next subtree to visit, front to back by
+    /// entry distance, skipping stacked subtrees that start beyond the
+    /// best hit. False when nothing is left to visit.
+    #[inline(always)]
+    pub(crate) fn closest_step<const AVX: bool>(
+        &self,
+        ctx: &RayCtx,
+        walk: &mut Walk,
+        stats: &mut TraversalStats,
+        stack: &mut TraversalStack,
+    ) -> bool {
         let TraversalStack { refs: stack_ref, ts: stack_t } = stack;
-        let mut sp = 0;
-        let mut cur = start;
-        'walk: loop {
-            if cur.is_leaf() {
-                let (first, count) = cur.leaf_range();
-                stats.items += count as u32;
-                for (k, item) in self.items[first..first + count].iter().enumerate() {
-                    item.closest((first + k) as u32, ctx, &mut best);
-                }
-            } else {
-                stats.nodes += 1;
-                let node = &self.nodes[cur.index()];
-                // A box entered at (rounded) distance just past the best hit
-                // may still hold an exact tie; widen the bound as the far
-                // planes are widened.
-                let bound = widen_far(best.t);
-                let (mask, tnear) = box_test::<AVX>(node, ctx, bound);
-                // Empty slots hold the empty box, which no ray enters
-                // (`validate` rejects blobs where they do not): `mask` names
-                // real children only. One or two children (most nodes) take
-                // a short path; more are sorted.
-                if mask != 0 {
-                    let i = mask.trailing_zeros() as usize;
-                    let rest = mask & (mask - 1);
-                    if rest == 0 {
-                        cur = node.children[i];
-                        continue 'walk;
-                    }
-                    let j = rest.trailing_zeros() as usize;
-                    if rest & (rest - 1) == 0 {
-                        let (ci, cj) = (node.children[i], node.children[j]);
-                        let (near, far, t_far) = if tnear[j] < tnear[i] {
-                            (cj, ci, tnear[i])
-                        } else {
-                            (ci, cj, tnear[j])
-                        };
-                        self.prefetch(far);
-                        stack_ref[sp].write(far);
-                        stack_t[sp].write(t_far);
-                        sp += 1;
-                        cur = near;
-                        continue 'walk;
-                    }
-                    // Gather the hit children with their entry distances.
-                    let mut refs = [ChildRef::EMPTY; WIDTH];
-                    let mut ts = [0.0f32; WIDTH];
-                    let mut k = 0;
-                    let mut m = mask;
-                    while m != 0 {
-                        let i = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        refs[k] = node.children[i];
-                        ts[k] = tnear[i];
-                        k += 1;
-                    }
-                    // Sort descending by entry distance (at most 8: insertion
-                    // sort), push all but the nearest, descend into it.
-                    for a in 1..k {
-                        let (r, t) = (refs[a], ts[a]);
-                        let mut b = a;
-                        while b > 0 && ts[b - 1] < t {
-                            refs[b] = refs[b - 1];
-                            ts[b] = ts[b - 1];
-                            b -= 1;
-                        }
-                        refs[b] = r;
-                        ts[b] = t;
-                    }
-                    for a in 0..k - 1 {
-                        // Start fetching what will be visited after the
-                        // nearest subtree, to overlap the memory latency.
-                        self.prefetch(refs[a]);
-                        stack_ref[sp].write(refs[a]);
-                        stack_t[sp].write(ts[a]);
-                        sp += 1;
-                    }
-                    cur = refs[k - 1];
-                    continue 'walk;
-                }
+        let Walk { cur, sp, best } = walk;
+        if cur.is_leaf() {
+            let (first, count) = cur.leaf_range();
+            stats.items += count as u32;
+            for (k, item) in self.leaf(first, count).iter().enumerate() {
+                item.closest((first + k) as u32, ctx, best);
             }
-            // Pop the next subtree that can still hold a closer hit.
-            loop {
-                if sp == 0 {
-                    break 'walk;
+        } else {
+            stats.nodes += 1;
+            let node = self.node(*cur);
+            // A box entered at (rounded) distance just past the best hit
+            // may still hold an exact tie; widen the bound as the far
+            // planes are widened.
+            let bound = widen_far(best.t);
+            let (mask, tnear) = box_test::<AVX>(node, ctx, bound);
+            // Empty slots hold the empty box, which no ray enters
+            // (`validate` rejects blobs where they do not): `mask` names
+            // real children only. One or two children (most nodes) take
+            // a short path; more are sorted.
+            if mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                let rest = mask & (mask - 1);
+                if rest == 0 {
+                    *cur = node.children[i];
+                    return true;
                 }
-                sp -= 1;
-                // SAFETY: entries below the pushes' count were written
-                // above (both arrays at every push).
-                let (t, r) = unsafe { (stack_t[sp].assume_init(), stack_ref[sp].assume_init()) };
-                if t <= widen_far(best.t) {
-                    cur = r;
-                    continue 'walk;
+                let j = rest.trailing_zeros() as usize;
+                if rest & (rest - 1) == 0 {
+                    let (ci, cj) = (node.children[i], node.children[j]);
+                    let (near, far, t_far) =
+                        if tnear[j] < tnear[i] { (cj, ci, tnear[i]) } else { (ci, cj, tnear[j]) };
+                    self.prefetch(far);
+                    stack_ref[*sp].write(far);
+                    stack_t[*sp].write(t_far);
+                    *sp += 1;
+                    *cur = near;
+                    return true;
                 }
+                // Gather the hit children with their entry distances.
+                let mut refs = [ChildRef::EMPTY; WIDTH];
+                let mut ts = [0.0f32; WIDTH];
+                let mut k = 0;
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    refs[k] = node.children[i];
+                    ts[k] = tnear[i];
+                    k += 1;
+                }
+                // Sort descending by entry distance (at most 8: insertion
+                // sort), push all but the nearest, descend into it.
+                for a in 1..k {
+                    let (r, t) = (refs[a], ts[a]);
+                    let mut b = a;
+                    while b > 0 && ts[b - 1] < t {
+                        refs[b] = refs[b - 1];
+                        ts[b] = ts[b - 1];
+                        b -= 1;
+                    }
+                    refs[b] = r;
+                    ts[b] = t;
+                }
+                for a in 0..k - 1 {
+                    // Start fetching what will be visited after the
+                    // nearest subtree, to overlap the memory latency.
+                    self.prefetch(refs[a]);
+                    stack_ref[*sp].write(refs[a]);
+                    stack_t[*sp].write(ts[a]);
+                    *sp += 1;
+                }
+                *cur = refs[k - 1];
+                return true;
             }
         }
-        best
+        // Pop the next subtree that can still hold a closer hit.
+        while *sp > 0 {
+            *sp -= 1;
+            // SAFETY: entries below the pushes' count were written above
+            // (both arrays at every push).
+            let (t, r) = unsafe { (stack_t[*sp].assume_init(), stack_ref[*sp].assume_init()) };
+            if t <= widen_far(best.t) {
+                *cur = r;
+                return true;
+            }
+        }
+        false
     }
+}
+
+/// What an occlusion step found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Step {
+    /// More to visit.
+    Go,
+    /// A hit: the ray is occluded.
+    Hit,
+    /// Nothing left: the ray is not occluded.
+    Done,
+}
+
+/// Where a traversal stands between two steps: the subtree to
+/// visit next, the stack height and the best hit so far.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Walk {
+    pub(crate) cur: ChildRef,
+    pub(crate) sp: usize,
+    pub(crate) best: BestHit,
 }
 
 /// The node test of kernel `AVX` (see [`box_test_avx`]) or the 4-wide one.
@@ -460,8 +525,9 @@ fn box_test_x4(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
     let mut tnear = [0.0f32; WIDTH];
     for g in 0..GROUPS {
         let slab = |a: usize| {
-            let near = F32x4::from_array(b[ctx.near[a]][g]).sub(ctx.org[a]).mul(ctx.inv[a]);
-            let far = F32x4::from_array(b[ctx.far[a]][g]).sub(ctx.org[a]).mul(ctx.inv[a]);
+            let (near, far) = ctx.planes(b, a);
+            let near = F32x4::from_array(near[g]).sub(ctx.org[a]).mul(ctx.inv[a]);
+            let far = F32x4::from_array(far[g]).sub(ctx.org[a]).mul(ctx.inv[a]);
             (near, far)
         };
         let (nx, fx) = slab(0);
@@ -502,8 +568,9 @@ unsafe fn box_test_avx(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WID
         // SAFETY: the caller guarantees AVX.
         unsafe {
             let (o, inv) = (F32x8::splat(ctx.ray.origin[a]), F32x8::splat(ctx.inv1[a]));
-            let near = F32x8::from_groups(b[ctx.near[a]]).sub(o).mul(inv);
-            let far = F32x8::from_groups(b[ctx.far[a]]).sub(o).mul(inv);
+            let (near, far) = ctx.planes(b, a);
+            let near = F32x8::from_groups(*near).sub(o).mul(inv);
+            let far = F32x8::from_groups(*far).sub(o).mul(inv);
             (near, far)
         }
     }

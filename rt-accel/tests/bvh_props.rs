@@ -115,6 +115,45 @@ proptest! {
         }
     }
 
+    /// Streams (rays some invalid, more rays than lanes, any count) report
+    /// every ray exactly once, with the single-ray query's answer, on every
+    /// kernel.
+    #[test]
+    fn streams_answer_as_single_rays(
+        (pos, idx) in soup(),
+        rays in prop::collection::vec(ray(), 0..40),
+        invalid in prop::collection::vec(0usize..40, 0..6),
+        p in quality(),
+    ) {
+        let bvh = build_triangles(&pos, &idx, &p).unwrap();
+        let mut rays = rays;
+        for &i in &invalid {
+            if let Some(r) = rays.get_mut(i) {
+                r.direction = Vec3::ZERO;
+            }
+        }
+        let th = |b: Option<rt_accel::BestHit>| b.map(|b| (b.t.to_bits(), b.prim));
+        for isa in Isa::available() {
+            let view = bvh.as_ref().with_isa(isa).unwrap();
+            let mut closest = vec![None; rays.len()];
+            let mut seen = vec![0u32; rays.len()];
+            view.closest_t_stream(&rays, |i, h| {
+                closest[i] = th(h);
+                seen[i] += 1;
+            });
+            let mut occluded = vec![None; rays.len()];
+            view.occluded_stream(&rays, |i, o| {
+                occluded[i] = Some(o);
+                seen[i] += 1;
+            });
+            prop_assert!(seen.iter().all(|&n| n == 2), "{}: {:?}", isa, seen);
+            for (i, r) in rays.iter().enumerate() {
+                prop_assert_eq!(closest[i], th(view.closest_t(r)), "{} ray {}", isa, i);
+                prop_assert_eq!(occluded[i], Some(view.occluded(r)), "{} ray {}", isa, i);
+            }
+        }
+    }
+
     #[test]
     fn spheres_match_brute_force(
         s in prop::collection::vec((vec3(10.0), 0.05f32..2.0).prop_map(|(c, r)| Sphere::new(c, r)), 1..100),
@@ -316,8 +355,28 @@ fn camera_packets_answer_as_single_rays() {
         }
     }
     assert!(hits > 1000, "the sphere must fill part of the view: {hits}");
+    // Streams over the same rays, on every kernel; an empty BVH's stream
+    // misses every ray once.
+    for isa in Isa::available() {
+        let view = bvh.as_ref().with_isa(isa).unwrap();
+        let th = |b: Option<rt_accel::BestHit>| b.map(|b| (b.t.to_bits(), b.prim));
+        let mut n = 0;
+        view.closest_t_stream(&rays, |i, h| {
+            assert_eq!(th(h), th(view.closest_t(&rays[i])), "{isa}");
+            n += 1;
+        });
+        view.occluded_stream(&rays, |i, o| {
+            assert_eq!(o, view.occluded(&rays[i]), "{isa}");
+            n += 1;
+        });
+        assert_eq!(n, 2 * rays.len());
+    }
     let nan = Ray::new(Vec3::NAN, Vec3::Z);
     assert_eq!(bvh.as_ref().closest_t_packet(&[nan; 8]), [None; 8]);
     let empty = build_triangles(&[], &[], &params()).unwrap();
     assert_eq!(empty.as_ref().occluded_packet(&rays[..8].try_into().unwrap()), [false; 8]);
+    let mut misses = 0;
+    empty.as_ref().closest_t_stream(&rays, |_, h| misses += usize::from(h.is_none()));
+    empty.as_ref().occluded_stream(&rays, |_, o| misses += usize::from(!o));
+    assert_eq!(misses, 2 * rays.len());
 }
