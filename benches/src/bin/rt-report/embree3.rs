@@ -74,3 +74,30 @@ impl EmbreeScene {
 pub(crate) fn context() -> IntersectContext {
     IntersectContext::incoherent()
 }
+
+impl EmbreeScene {
+    /// All rays at once through Embree's stream API (`rtcIntersect1M` /
+    /// `rtcOccluded1M`, array of structures): (hits, Σt).
+    pub(crate) fn stream(
+        &self,
+        ctx: &mut IntersectContext,
+        rays: &[rt_core::Ray],
+        closest: bool,
+    ) -> (u64, f64) {
+        let to = |r: &rt_core::Ray| {
+            let (o, d) = (r.origin, r.direction);
+            Ray::segment(Vector3::new(o.x, o.y, o.z), Vector3::new(d.x, d.y, d.z), r.t_min, r.t_max)
+        };
+        if closest {
+            let mut rh: Vec<RayHit> = rays.iter().map(|r| RayHit::new(to(r))).collect();
+            self.scene.intersect_stream_aos(ctx, &mut rh);
+            rh.iter()
+                .filter(|h| h.hit.hit())
+                .fold((0, 0.0), |(n, s), h| (n + 1, s + f64::from(h.ray.tfar)))
+        } else {
+            let mut r: Vec<Ray> = rays.iter().map(to).collect();
+            self.scene.occluded_stream_aos(ctx, &mut r);
+            (r.iter().filter(|r| r.tfar == f32::NEG_INFINITY).count() as u64, 0.0)
+        }
+    }
+}
