@@ -95,7 +95,7 @@ pub use prim::{BestHit, CapsuleItem, Primitive, SphereItem};
 pub use ray_ctx::RayCtx;
 #[cfg(feature = "alloc")]
 pub use scene::Scene;
-pub use stream::STREAM;
+pub use stream::{GROUP, STREAM};
 pub use traverse::{BvhRef, MAX_DEPTH, STACK_SIZE, TraversalStack, TraversalStats};
 pub use tri_packet::TriPacket;
 

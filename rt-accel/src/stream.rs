@@ -1,23 +1,28 @@
-//! Streams: many independent rays traced in one loop, a few at a time.
+//! Streams: many independent rays traced in one call.
 //!
 //! A single ray's traversal is one long chain of dependent steps: load a
 //! node, test its boxes, pick a child, load that child. Each step waits for
-//! the one before, so most of a core's execution units sit idle (measured:
-//! ~45 cycles per node on the terrain, whether the nodes are in L1 or not).
-//! A stream keeps [`STREAM`] rays in flight and advances each by one step
-//! in turn, so the chains of different rays overlap in the core's
+//! the one before, so most of a core's execution units sit idle. Closest
+//! hits keep [`STREAM`] rays in flight and advance each by one step in
+//! turn, so the chains of different rays overlap in the core's
 //! out-of-order window; a ray that finishes hands its lane to the next ray
-//! of the stream. Every ray runs exactly its single-ray traversal (the same
-//! steps, the same arithmetic), so its answer equals the single-ray query
-//! bit for bit; only the order in which answers are reported differs.
+//! of the stream. Occlusion walks the tree with groups of [`GROUP`] rays
+//! (as Embree's ray streams do): a node is fetched once for every ray of
+//! the group that reaches it, each ray testing it with the single-ray box
+//! test, and a subtree is pushed with the rays that entered it.
+//!
+//! Either way every ray enters exactly the subtrees its single-ray
+//! traversal would enter, with the same arithmetic, so its answer equals
+//! the single-ray query bit for bit; only the order in which answers are
+//! reported differs.
 
-use rt_core::Ray;
+use rt_core::{Ray, internal::widen_far};
 
 use crate::{
     Isa, RayCtx,
-    node::ChildRef,
+    node::{ChildRef, WIDTH},
     prim::{BestHit, Primitive},
-    traverse::{BvhRef, Step, TraversalStack, TraversalStats, Walk},
+    traverse::{BvhRef, STACK_SIZE, TraversalStack, TraversalStats, Walk, box_test},
 };
 
 /// Rays a stream keeps in flight.
@@ -114,8 +119,8 @@ impl<P: Primitive> BvhRef<'_, P> {
     }
 
     /// Whether each ray of `rays` is occluded, as [`BvhRef::occluded`]
-    /// answers, reported as `out(index, occluded)` once per ray, in the
-    /// order rays finish; [`STREAM`] traversals overlap in the core.
+    /// answers, reported as `out(index, occluded)` once per ray (in
+    /// groups); groups of [`GROUP`] rays walk the tree together.
     pub fn occluded_stream(&self, rays: &[Ray], mut out: impl FnMut(usize, bool)) {
         if self.nodes.is_empty() {
             (0..rays.len()).for_each(|i| out(i, false));
@@ -144,33 +149,117 @@ impl<P: Primitive> BvhRef<'_, P> {
         self.occluded_stream_kernel::<true>(rays, out);
     }
 
-    /// The stream kernel of [`BvhRef::occluded_stream`] (non-empty BVH).
+    /// The stream kernel of [`BvhRef::occluded_stream`] (non-empty BVH):
+    /// groups of up to [`GROUP`] consecutive valid rays.
     #[inline(always)]
     fn occluded_stream_kernel<const AVX: bool>(
         &self,
         rays: &[Ray],
         out: &mut dyn FnMut(usize, bool),
     ) {
-        let mut stacks = [const { TraversalStack::new() }; STREAM];
-        let mut next = 0;
-        let mut lanes: [Option<Lane>; STREAM] =
-            core::array::from_fn(|_| next_lane(rays, &mut next, |i| out(i, false)));
-        loop {
-            let mut live = false;
-            for (lane, stack) in lanes.iter_mut().zip(&mut stacks) {
-                let Some(l) = lane else { continue };
-                live = true;
-                let answer = match self.occluded_step::<AVX>(&l.ctx, &mut l.walk, stack) {
-                    Step::Go => continue,
-                    Step::Hit => true,
-                    Step::Done => false,
-                };
-                out(l.index, answer);
-                *lane = next_lane(rays, &mut next, |i| out(i, false));
-            }
-            if !live {
-                return;
+        // Filler for the unused end of the group arrays (never read).
+        let Some(filler) = RayCtx::new(&Ray::new(glam::Vec3::ZERO, glam::Vec3::X)) else {
+            return;
+        };
+        let mut ctxs = [filler; GROUP];
+        let mut index = [0usize; GROUP];
+        let mut stack = GroupStack::new();
+        let mut n = 0;
+        for (i, ray) in rays.iter().enumerate() {
+            let Some(ctx) = RayCtx::new(ray) else {
+                out(i, false);
+                continue;
+            };
+            ctxs[n] = ctx;
+            index[n] = i;
+            n += 1;
+            if n == GROUP {
+                let hit = self.occluded_group::<AVX>(&ctxs, &mut stack);
+                (0..GROUP).for_each(|r| out(index[r], hit >> r & 1 != 0));
+                n = 0;
             }
         }
+        if n > 0 {
+            let hit = self.occluded_group::<AVX>(&ctxs[..n], &mut stack);
+            (0..n).for_each(|r| out(index[r], hit >> r & 1 != 0));
+        }
+    }
+
+    /// Whether each ray of the group is occluded (bit `r` for `ctxs[r]`),
+    /// the group walking the tree together: each node is fetched once for
+    /// every ray that reaches it, and each ray tests its boxes and leaves
+    /// with the single-ray tests, so it enters exactly the subtrees its
+    /// own traversal would enter (until it is found occluded) and gets the
+    /// same answer. A subtree is pushed with the rays that entered it; a
+    /// ray found occluded drops out of every pending subtree.
+    #[inline(always)]
+    fn occluded_group<const AVX: bool>(&self, ctxs: &[RayCtx], stack: &mut GroupStack) -> u32 {
+        let all = if ctxs.len() >= 32 { u32::MAX } else { (1u32 << ctxs.len()) - 1 };
+        let mut occluded = 0u32;
+        let mut sp = 0;
+        let (mut cur, mut rays) = (ChildRef::inner(0), all);
+        loop {
+            let active = rays & !occluded;
+            if active != 0 {
+                if cur.is_leaf() {
+                    let (first, count) = cur.leaf_range();
+                    let items = self.leaf(first, count);
+                    let mut m = active;
+                    while m != 0 {
+                        let r = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let ctx = &ctxs[r];
+                        if items.iter().any(|it| it.any(ctx, ctx.ray.t_max)) {
+                            occluded |= 1 << r;
+                        }
+                    }
+                    if occluded == all {
+                        return occluded;
+                    }
+                } else {
+                    let node = self.node(cur);
+                    // The rays entering each child.
+                    let mut child = [0u32; WIDTH];
+                    let mut m = active;
+                    while m != 0 {
+                        let r = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let ctx = &ctxs[r];
+                        // Widened as in the single-ray occlusion test.
+                        let (hit, _) = box_test::<AVX>(node, ctx, widen_far(ctx.ray.t_max));
+                        // Branch-free: which children a ray enters is
+                        // unpredictable.
+                        for (i, c) in child.iter_mut().enumerate() {
+                            *c |= (hit >> i & 1) << r;
+                        }
+                    }
+                    for i in (0..WIDTH).rev() {
+                        if child[i] != 0 {
+                            stack.0[sp] = (node.children[i], child[i]);
+                            sp += 1;
+                        }
+                    }
+                }
+            }
+            if sp == 0 {
+                return occluded;
+            }
+            sp -= 1;
+            (cur, rays) = stack.0[sp];
+        }
+    }
+}
+
+/// Rays an occlusion stream walks the tree with together (bits of a `u32`).
+pub const GROUP: usize = 32;
+
+/// The pending subtrees of a group and the rays that entered each. Each
+/// level leaves at most `WIDTH − 1` siblings pending and pushes at most
+/// `WIDTH`, so `STACK_SIZE` entries hold a tree of `MAX_DEPTH` levels.
+struct GroupStack([(ChildRef, u32); STACK_SIZE]);
+
+impl GroupStack {
+    fn new() -> Self {
+        Self([(ChildRef::EMPTY, 0); STACK_SIZE])
     }
 }

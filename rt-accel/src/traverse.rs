@@ -502,7 +502,11 @@ pub(crate) struct Walk {
 
 /// The node test of kernel `AVX` (see [`box_test_avx`]) or the 4-wide one.
 #[inline(always)]
-fn box_test<const AVX: bool>(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
+pub(crate) fn box_test<const AVX: bool>(
+    node: &Node,
+    ctx: &RayCtx,
+    t_max: f32,
+) -> (u32, [f32; WIDTH]) {
     #[cfg(target_arch = "x86_64")]
     if AVX {
         // SAFETY: `AVX` kernels are instantiated only inside the functions

@@ -98,7 +98,15 @@ fn compare(raster: &Path, traced: &Path, background: [u8; 3]) -> (f64, f64) {
             diff += (0..3).map(|k| f64::from(pa[k].abs_diff(pb[k]))).sum::<f64>() / 3.0;
         }
     }
-    (agree as f64 / (w * h) as f64, if both == 0 { 0.0 } else { diff / both as f64 })
+    let (agree, diff) =
+        (agree as f64 / (w * h) as f64, if both == 0 { 0.0 } else { diff / both as f64 });
+    // The measured numbers, for `--nocapture` runs and the notes.
+    eprintln!(
+        "{}: coverage agrees on {:.2} %, mean colour difference {diff:.2}/255",
+        traced.display(),
+        100.0 * agree
+    );
+    (agree, diff)
 }
 
 fn counters(dir: &Path) -> std::collections::HashMap<String, u64> {
