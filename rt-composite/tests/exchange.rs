@@ -163,13 +163,18 @@ fn a_silent_rank_is_an_error_everywhere_within_the_timeout() {
     for (r, res) in out.iter().enumerate() {
         assert!(res.is_err(), "rank {r} must fail: {res:?}");
     }
-    // Ranks 0, 1, 3 fail on the timeout (or on a peer's abort); rank 2
-    // sleeps 3 s after its own failure, so the others' failures are
-    // timed by their own error messages, not by the join.
+    // Ranks 0, 1, 3 fail on the timeout, on a peer's abort, or on a peer
+    // that already failed and hung up (under load one rank's timeout can
+    // fire well before another's); rank 2 sleeps 3 s after its own
+    // failure, so the others' failures are timed by their own error
+    // messages, not by the join.
     assert!(elapsed < Duration::from_secs(6), "{elapsed:?}");
     for r in [0, 1, 3] {
         let e = out[r].as_ref().unwrap_err();
-        assert!(e.contains("timed out") || e.contains("failed"), "rank {r}: {e}");
+        assert!(
+            e.contains("timed out") || e.contains("failed") || e.contains("is gone"),
+            "rank {r}: {e}"
+        );
     }
 }
 
