@@ -214,58 +214,41 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         start: ChildRef,
         stack: &mut TraversalStack,
     ) -> bool {
-        let mut walk = Walk { cur: start, sp: 0, best: BestHit::new(ctx.ray.t_max) };
-        loop {
-            match self.occluded_step::<AVX>(ctx, &mut walk, stack) {
-                Step::Go => {}
-                Step::Hit => return true,
-                Step::Done => return false,
-            }
-        }
-    }
-
-    /// One step of an occlusion traversal: visits `walk.cur` and pops the
-    /// next subtree (`walk.best` is not used).
-    #[inline(always)]
-    pub(crate) fn occluded_step<const AVX: bool>(
-        &self,
-        ctx: &RayCtx,
-        walk: &mut Walk,
-        stack: &mut TraversalStack,
-    ) -> Step {
         let t_max = ctx.ray.t_max;
         let stack = &mut stack.refs;
-        let Walk { cur, sp, .. } = walk;
-        if cur.is_leaf() {
-            let (first, count) = cur.leaf_range();
-            for item in self.leaf(first, count) {
-                if item.any(ctx, t_max) {
-                    return Step::Hit;
+        let mut sp = 0;
+        let mut cur = start;
+        loop {
+            if cur.is_leaf() {
+                let (first, count) = cur.leaf_range();
+                for item in self.leaf(first, count) {
+                    if item.any(ctx, t_max) {
+                        return true;
+                    }
+                }
+            } else {
+                let node = self.node(cur);
+                // Widened as in `closest_step`: a box entered at a rounded
+                // distance just past `t_max` may hold a hit at exactly
+                // `t_max` (found by the `bvh` fuzz target with
+                // `t_min = t_max`).
+                let (mask, _) = box_test::<AVX>(node, ctx, widen_far(t_max));
+                // Empty slots are never entered (see `closest_step`).
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    stack[sp].write(node.children[i]);
+                    sp += 1;
                 }
             }
-        } else {
-            let node = self.node(*cur);
-            // Widened as in `closest_step`: a box entered at a rounded
-            // distance just past `t_max` may hold a hit at exactly
-            // `t_max` (found by the `bvh` fuzz target with
-            // `t_min = t_max`).
-            let (mask, _) = box_test::<AVX>(node, ctx, widen_far(t_max));
-            // Empty slots are never entered (see `closest_step`).
-            let mut m = mask;
-            while m != 0 {
-                let i = m.trailing_zeros() as usize;
-                m &= m - 1;
-                stack[*sp].write(node.children[i]);
-                *sp += 1;
+            if sp == 0 {
+                return false;
             }
+            sp -= 1;
+            // SAFETY: entries below the pushes' count were written above.
+            cur = unsafe { stack[sp].assume_init() };
         }
-        if *sp == 0 {
-            return Step::Done;
-        }
-        *sp -= 1;
-        // SAFETY: entries below the pushes' count were written above.
-        *cur = unsafe { stack[*sp].assume_init() };
-        Step::Go
     }
 
     /// Inner node `c`.
@@ -480,18 +463,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     }
 }
 
-/// What an occlusion step found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Step {
-    /// More to visit.
-    Go,
-    /// A hit: the ray is occluded.
-    Hit,
-    /// Nothing left: the ray is not occluded.
-    Done,
-}
-
-/// Where a traversal stands between two steps: the subtree to
+/// Where a closest-hit traversal stands between two steps: the subtree to
 /// visit next, the stack height and the best hit so far.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Walk {
