@@ -40,11 +40,17 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     let mut po = p + d * side;
     // Rounded away along the normal even where the bound is 0 (a hit on
     // an axis-aligned plane is exact): the origin must leave the surface.
+    // The step must also survive the slab distance `(plane − o)·(1/w)`
+    // that every hit is re-checked with (`triangle_admits_hit`): one ulp
+    // off a plane through 0 is a subnormal, which that product rounds to
+    // −0 once `|w| > 1`, so the plane was hit at `t = −0`. At least
+    // `4·MIN_POSITIVE·|w|` away, the product is a normal number.
     for i in 0..3 {
+        let step = 4.0 * f32::MIN_POSITIVE * w[i].abs();
         if side[i] > 0.0 {
-            po[i] = next_float_up(po[i]);
+            po[i] = next_float_up(po[i]).max(p[i] + step);
         } else if side[i] < 0.0 {
-            po[i] = next_float_down(po[i]);
+            po[i] = next_float_down(po[i]).min(p[i] - step);
         }
     }
     po
@@ -108,5 +114,41 @@ mod tests {
             let s = spawn_ray_to(h.position, h.position_error, h.normal, light);
             assert!(intersect_triangle(&s, v0, v1, v2).is_none());
         }
+    }
+
+    #[test]
+    fn shadow_rays_leave_an_exact_plane_through_zero() {
+        // A floor `y = 0` whose hits are exact in y (error bound 0): one
+        // ulp up from 0 is a subnormal, which vanished from the slab
+        // distance `(0 − o.y) / d.y` when `d.y > 1` and let the floor
+        // shadow itself at `t = −0` (found by the renderer's shadow test).
+        let floor =
+            [Vec3::new(-50.0, 0.0, -50.0), Vec3::new(-50.0, 0.0, 50.0), Vec3::new(50.0, 0.0, 50.0)];
+        let lamp = Vec3::new(-1.0, 2.5, 1.5);
+        let mut tried = 0;
+        for i in 0..64 {
+            for j in 0..64 {
+                let above = Vec3::new(-4.0 + 0.125 * i as f32, 5.0, -4.0 + 0.125 * j as f32);
+                let r = Ray::new(above, Vec3::NEG_Y);
+                let Some(h) = intersect_triangle(&r, floor[0], floor[1], floor[2]) else {
+                    continue;
+                };
+                assert_eq!(h.position_error.y, 0.0);
+                for target in [lamp, lamp * 40.0, h.position + Vec3::new(-3.0, 1e-3, 0.5)] {
+                    let s = spawn_ray_to(h.position, h.position_error, h.normal, target);
+                    assert!(
+                        intersect_triangle(&s, floor[0], floor[1], floor[2]).is_none(),
+                        "{s:?}"
+                    );
+                    let d = spawn_ray(h.position, h.position_error, h.normal, target - h.position);
+                    assert!(
+                        intersect_triangle(&d, floor[0], floor[1], floor[2]).is_none(),
+                        "{d:?}"
+                    );
+                }
+                tried += 1;
+            }
+        }
+        assert!(tried > 1000);
     }
 }
