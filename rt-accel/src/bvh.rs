@@ -196,6 +196,10 @@ impl<P: Primitive> SceneQuery for Bvh<P> {
         self.as_ref().occluded(ray)
     }
 
+    fn occluded_batch(&self, rays: &[Ray], out: &mut [bool]) {
+        self.as_ref().occluded_batch(rays, out);
+    }
+
     fn closest_hit_packet(&self, rays: &[Ray; crate::PACKET]) -> [Option<Hit>; crate::PACKET] {
         self.as_ref().closest_hit_packet(rays)
     }

@@ -51,4 +51,13 @@ impl SceneQuery for Scene {
     fn occluded(&self, ray: &Ray) -> bool {
         self.triangles.occluded(ray) || self.spheres.occluded(ray) || self.capsules.occluded(ray)
     }
+
+    /// The triangles as one stream; spheres and capsules ray by ray for
+    /// the rays the triangles leave open, as [`Scene::occluded`].
+    fn occluded_batch(&self, rays: &[Ray], out: &mut [bool]) {
+        self.triangles.occluded_batch(rays, out);
+        for (ray, o) in rays.iter().zip(out) {
+            *o = *o || self.spheres.occluded(ray) || self.capsules.occluded(ray);
+        }
+    }
 }

@@ -575,6 +575,12 @@ impl<P: Primitive> SceneQuery for BvhRef<'_, P> {
         BvhRef::occluded(self, ray)
     }
 
+    /// Through [`BvhRef::occluded_stream`]: the same answers.
+    fn occluded_batch(&self, rays: &[Ray], out: &mut [bool]) {
+        let n = rays.len().min(out.len());
+        self.occluded_stream(&rays[..n], |i, o| out[i] = o);
+    }
+
     fn closest_hit_packet(&self, rays: &[Ray; crate::PACKET]) -> [Option<Hit>; crate::PACKET] {
         let best = self.closest_t_packet(rays);
         // The same primitive's record whichever stored copy was found.

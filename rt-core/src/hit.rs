@@ -55,4 +55,15 @@ pub trait SceneQuery {
     fn closest_hit_packet(&self, rays: &[Ray; 8]) -> [Option<Hit>; 8] {
         core::array::from_fn(|i| self.closest_hit(&rays[i]))
     }
+    /// [`SceneQuery::occluded`] of many rays: `out[i] = occluded(&rays[i])`
+    /// for every `i` below the shorter of the two lengths. Scenes that walk
+    /// rays through the tree together (rt-accel's occlusion streams)
+    /// override it; the default asks ray by ray. Shading code whose later
+    /// work does not depend on the answers (shadow and AO rays) gathers
+    /// its rays and asks once.
+    fn occluded_batch(&self, rays: &[Ray], out: &mut [bool]) {
+        for (ray, o) in rays.iter().zip(out) {
+            *o = self.occluded(ray);
+        }
+    }
 }

@@ -473,3 +473,104 @@ fn bad_geometry_is_named_and_moving_vertices_refits() {
     s.replace_mesh(1, tri).unwrap();
     assert_eq!((s.refits(), s.rebuilds(), s.triangle_count()), (1, 1, 3));
 }
+
+#[test]
+fn shadows_of_many_pixels_fall_where_the_geometry_puts_them() {
+    // Spheres above a floor, seen from straight above, lit by a red
+    // directional light and a green point light with shadows. Each floor
+    // pixel's colour is set by whether each of its two shadow rays meets a
+    // sphere, found here ray by ray in f64. The renderer gathers a tile's
+    // shadow rays and answers them together: an answer given to the wrong
+    // pixel or the wrong light shows here.
+    let centres: Vec<Vec3> = (0..12)
+        .map(|i| {
+            let a = i as f32 * 2.4;
+            Vec3::new(0.35 * i as f32 * a.cos(), 0.8 + 0.05 * i as f32, 0.35 * i as f32 * a.sin())
+        })
+        .collect();
+    let radius = 0.45;
+    let glyphs = Glyphs {
+        spheres: centres.iter().map(|&c| Sphere::new(c, radius)).collect(),
+        scalars: None,
+        paint: Paint::Solid([1.0; 3]),
+        material: Material::MATTE,
+    };
+    let sc = SurfaceScene::build(
+        vec![solid(floor(), [1.0; 3], Material::MATTE)],
+        vec![glyphs],
+        vec![],
+        &BuildParams::medium(),
+    )
+    .unwrap();
+    let l = Vec3::new(0.6, 1.0, -0.3).normalize();
+    let lamp = Vec3::new(-1.0, 2.5, 1.5);
+    let st = Settings {
+        lights: vec![
+            Light::Directional { direction: l, color: [1.0, 0.0, 0.0] },
+            Light::Point { position: lamp, color: [0.0, 4.0, 0.0] },
+        ],
+        shadows: true,
+        ao_samples: 0,
+        ..Settings::default()
+    };
+    let n = 64;
+    let cam = Camera::look_at(
+        Vec3::new(0.0, 5.0, 0.0),
+        Vec3::ZERO,
+        Vec3::Z,
+        Projection::Orthographic { height: 8.0 },
+        n,
+        n,
+    )
+    .unwrap();
+    let (f, _) = render(&sc, cam, st, 1);
+    // Distance from the segment `p + s·d`, `s ∈ [0, s_max]`, to the nearest
+    // sphere surface (negative: the segment passes through a sphere).
+    let clearance = |p: Vec3, d: Vec3, s_max: f64| -> f64 {
+        let (p, d) = (p.as_dvec3(), d.as_dvec3().normalize());
+        centres
+            .iter()
+            .map(|c| {
+                let c = c.as_dvec3();
+                let s = (c - p).dot(d).clamp(0.0, s_max);
+                (p + s * d).distance(c) - f64::from(radius)
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let (mut checked, mut red_shadowed, mut green_shadowed) = (0, 0, 0);
+    for y in 0..n {
+        for x in 0..n {
+            let ray =
+                cam.generate_ray(x, y, rt_core::glam::Vec2::splat(0.5), rt_core::glam::Vec2::ZERO);
+            // The floor point under the pixel, if no sphere is in the way.
+            let t = -ray.origin.y / ray.direction.y;
+            let p = ray.origin + t * ray.direction;
+            if clearance(ray.origin, ray.direction, f64::from(t)) < 0.02 {
+                continue;
+            }
+            let to_lamp = lamp - p;
+            let (red, green) =
+                (clearance(p, l, 1e3), clearance(p, to_lamp, f64::from(to_lamp.length())));
+            if red.abs() < 0.02 || green.abs() < 0.02 {
+                continue; // too close to a shadow's edge to call
+            }
+            let want_r = if red < 0.0 { 0.0 } else { l.y };
+            let want_g = if green < 0.0 {
+                0.0
+            } else {
+                4.0 * to_lamp.normalize().y / to_lamp.length_squared()
+            };
+            let c = f.get(x, y).unwrap().color;
+            assert!(
+                (c[0] - want_r).abs() < 1e-4 && (c[1] - want_g).abs() < 1e-4,
+                "pixel ({x}, {y}) at {p}: {c:?}, want red {want_r} green {want_g} ({red} {green})"
+            );
+            checked += 1;
+            red_shadowed += usize::from(red < 0.0);
+            green_shadowed += usize::from(green < 0.0);
+        }
+    }
+    // Enough pixels of each kind for a misplaced answer to show.
+    assert!(checked > 3000, "{checked}");
+    assert!(red_shadowed > 300 && green_shadowed > 300, "{red_shadowed} {green_shadowed}");
+}

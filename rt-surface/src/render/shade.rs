@@ -3,7 +3,7 @@
 //! occlusion and mirror bounces. Each pixel draws from its own random
 //! stream, so the image does not depend on which thread renders it.
 
-use alloc::vec::Vec;
+use alloc::vec::{self, Vec};
 
 use glam::{Vec2, Vec3};
 use rt_core::{
@@ -32,32 +32,55 @@ pub(super) struct Ctx<'a, S> {
     pub(super) bounds: Aabb,
 }
 
-/// Per-pixel state: its random stream and its counts.
+/// Per-pixel state: its random stream, its counts and how its rays are
+/// answered.
 struct PixelWork {
     rng: Rng,
     counts: RayCounts,
+    trace: Trace,
 }
+
+/// How a tile's rays are answered. A tile that asks occlusion queries is
+/// walked twice: the first walk traces its closest hits and gathers its
+/// shadow and AO rays (answering "open"), one
+/// [`SceneQuery::occluded_batch`](rt_core::SceneQuery::occluded_batch)
+/// answers them all (rt-accel walks them through the tree together), and
+/// the second walk replays the hits and the answers in order. The queries
+/// never depend on the answers: a pixel's shadow rays and AO directions
+/// come from its hits and its own random stream, whether or not an earlier
+/// one was blocked, and no hit is traced after an occlusion query that
+/// depends on it. So the second walk asks exactly what the first gathered,
+/// and the frame equals the ray-by-ray one bit for bit.
+enum Trace {
+    /// The first walk: closest hits as traced, occlusion rays to answer.
+    Gather { hits: Vec<Option<Hit>>, rays: Vec<Ray> },
+    /// The second walk: the first walk's hits and the answers, in order.
+    Replay { hits: vec::IntoIter<Option<Hit>>, answers: vec::IntoIter<bool> },
+}
+
+/// A ray no scene is hit by (NaN origin: [`Ray::is_valid`] fails).
+const NO_RAY: Ray = Ray { origin: Vec3::NAN, direction: Vec3::Z, t_min: 0.0, t_max: 0.0 };
 
 impl<S: ShadeScene> Ctx<'_, S> {
     pub(super) fn tile(&self, x0: u32, y0: u32, pass: u32) -> TileResult {
         let (w, h) = (self.camera.width, self.camera.height);
         let (tw, th) = (TILE.min(w - x0), TILE.min(h - y0));
-        let mut pixels = Vec::with_capacity((tw * th) as usize);
         let stream_seed = self.settings.seed ^ u64::from(pass).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-        let mut pw = PixelWork { rng: rng_for(stream_seed, 0), counts: RayCounts::default() };
+        let mut counts = RayCounts::default();
         // Camera rays eight pixels of a row at a time, traced as a packet
         // (`SceneQuery::closest_hit_packet`: the same hits as one by one);
         // each pixel keeps its own random stream for the rest of its path.
-        let none = Ray::new(Vec3::NAN, Vec3::Z);
+        let mut starts: Vec<(Ray, Option<Hit>, Rng)> = Vec::with_capacity((tw * th) as usize);
         for y in y0..y0 + th {
             let mut x = x0;
             while x < x0 + tw {
                 let n = (x0 + tw - x).min(8) as usize;
-                let mut rays = [none; 8];
-                let mut streams: [Rng; 8] = core::array::from_fn(|_| pw.rng.clone());
-                for (k, (ray, rng)) in rays.iter_mut().zip(&mut streams).take(n).enumerate() {
+                let mut rays = [NO_RAY; 8];
+                let mut streams: [Option<Rng>; 8] = [const { None }; 8];
+                for (k, (ray, stream)) in rays.iter_mut().zip(&mut streams).take(n).enumerate() {
                     let px = x + k as u32;
-                    *rng = rng_for(stream_seed, u64::from(y) * u64::from(w) + u64::from(px));
+                    let rng = stream
+                        .insert(rng_for(stream_seed, u64::from(y) * u64::from(w) + u64::from(px)));
                     let jitter = if pass == 0 { Vec2::splat(0.5) } else { uniform2(rng) };
                     *ray = self.camera.generate_ray(px, y, jitter, uniform2(rng));
                 }
@@ -66,36 +89,86 @@ impl<S: ShadeScene> Ctx<'_, S> {
                     k < n && self.bounds.intersect_ray(&rays[k]).is_none()
                 });
                 let traced: [Ray; 8] =
-                    core::array::from_fn(|k| if culled[k] { none } else { rays[k] });
+                    core::array::from_fn(|k| if culled[k] { NO_RAY } else { rays[k] });
                 let first = self.scene.closest_hit_packet(&traced);
-                for k in 0..n {
-                    pw.rng = streams[k].clone();
-                    pw.counts.primary += 1;
-                    pw.counts.culled += u64::from(culled[k]);
-                    let (rgb, a, depth) = self.path_from(rays[k], first[k], 0, &mut pw);
-                    pixels.push(([rgb.x, rgb.y, rgb.z, a], depth));
+                for (k, stream) in streams.into_iter().take(n).enumerate() {
+                    counts.primary += 1;
+                    counts.culled += u64::from(culled[k]);
+                    if let Some(rng) = stream {
+                        starts.push((rays[k], first[k], rng));
+                    }
                 }
                 x += n as u32;
             }
         }
+        let trace = Trace::Gather { hits: Vec::new(), rays: Vec::new() };
+        let mut pw = PixelWork { rng: rng_for(stream_seed, 0), counts, trace };
+        let mut pixels = self.walk(&starts, &mut pw);
+        if let Trace::Gather { hits, rays } = pw.trace
+            && !rays.is_empty()
+        {
+            let mut answers = alloc::vec![false; rays.len()];
+            self.scene.occluded_batch(&rays, &mut answers);
+            let trace = Trace::Replay { hits: hits.into_iter(), answers: answers.into_iter() };
+            // Counted in the first walk already.
+            let mut replay = PixelWork { rng: pw.rng, counts: RayCounts::default(), trace };
+            pixels = self.walk(&starts, &mut replay);
+        }
         TileResult { x0, y0, w: tw, pixels, counts: pw.counts }
+    }
+
+    /// Each pixel's colour, alpha and depth from its camera ray, first hit
+    /// and random stream.
+    fn walk(&self, starts: &[(Ray, Option<Hit>, Rng)], pw: &mut PixelWork) -> Vec<([f32; 4], f32)> {
+        starts
+            .iter()
+            .map(|(ray, first, rng)| {
+                pw.rng = rng.clone();
+                let (rgb, a, depth) = self.path_from(*ray, *first, 0, pw);
+                ([rgb.x, rgb.y, rgb.z, a], depth)
+            })
+            .collect()
     }
 
     /// The closest hit, not traversing rays that miss the scene's box.
     fn closest(&self, ray: &Ray, pw: &mut PixelWork) -> Option<Hit> {
-        if self.bounds.intersect_ray(ray).is_none() {
+        let hits = match &mut pw.trace {
+            Trace::Replay { hits, .. } => {
+                let hit = hits.next();
+                debug_assert!(hit.is_some(), "the replay asks what the first walk traced");
+                return hit.flatten();
+            }
+            Trace::Gather { hits, .. } => hits,
+        };
+        let hit = if self.bounds.intersect_ray(ray).is_none() {
             pw.counts.culled += 1;
-            return None;
-        }
-        self.scene.closest_hit(ray)
+            None
+        } else {
+            self.scene.closest_hit(ray)
+        };
+        hits.push(hit);
+        hit
     }
 
+    /// Whether `ray` is blocked: "no" while gathering (the ray is kept for
+    /// the batch), the batch's answer when replaying. Rays that miss the
+    /// scene's box are neither gathered nor traced, in both walks.
     fn occluded(&self, ray: &Ray, pw: &mut PixelWork) -> bool {
         if self.bounds.intersect_ray(ray).is_none() {
             pw.counts.culled += 1;
             return false;
         }
-        self.scene.occluded(ray)
+        match &mut pw.trace {
+            Trace::Replay { answers, .. } => {
+                let answer = answers.next();
+                debug_assert!(answer.is_some(), "the replay asks what the first walk gathered");
+                answer.unwrap_or(false)
+            }
+            Trace::Gather { rays, .. } => {
+                rays.push(*ray);
+                false
+            }
+        }
     }
 
     /// Premultiplied colour, alpha and depth seen along `ray`: translucent

@@ -266,6 +266,10 @@ impl SceneQuery for SurfaceScene<'_> {
     fn occluded(&self, ray: &Ray) -> bool {
         self.scene.occluded(ray)
     }
+
+    fn occluded_batch(&self, rays: &[Ray], out: &mut [bool]) {
+        self.scene.occluded_batch(rays, out);
+    }
 }
 
 impl ShadeScene for SurfaceScene<'_> {
