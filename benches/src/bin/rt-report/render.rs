@@ -184,7 +184,8 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
                     // The same frame with occlusion asked ray by ray.
                     let mut by_ray = Samples::default();
                     for _ in 0..if quick { 1 } else { 3 } {
-                        let mut r = Renderer::new(cam, settings.clone()).map_err(|e| e.to_string())?;
+                        let mut r =
+                            Renderer::new(cam, settings.clone()).map_err(|e| e.to_string())?;
                         let (s, _) = time(|| pool.install(|| r.render_pass(&RayByRay(&scene))));
                         by_ray.0.push(s);
                     }
