@@ -1,39 +1,28 @@
 //! Per-ray constants shared by the box tests and the leaf tests.
 
-use rt_core::{
-    Ray,
-    internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG, widen_far},
-    intersect::WatertightRay,
-};
+use rt_core::{Ray, internal::widen_far, intersect::WatertightRay};
 
 use crate::simd::F32x4;
 
-/// Everything a traversal precomputes once per ray: splatted origin and
-/// reciprocal direction, the near/far plane selection by direction sign, and
-/// the watertight triangle shear.
+/// Everything a traversal precomputes once per ray: the reciprocal
+/// direction, the near/far plane selection by direction sign, and the
+/// watertight triangle shear. Scalars only (80 bytes): kernels broadcast
+/// them into SIMD lanes where they use them, which costs one load each,
+/// while splatting them here made the context five times larger and its
+/// construction a third of a missed ray's cost.
 #[derive(Clone, Copy, Debug)]
 pub struct RayCtx {
     pub(crate) ray: Ray,
-    /// Origin per axis, splatted.
-    pub(crate) org: [F32x4; 3],
     /// Reciprocal direction per axis (`±∞` for `±0`).
     pub(crate) inv1: glam::Vec3,
-    /// Reciprocal direction per axis, splatted.
-    pub(crate) inv: [F32x4; 3],
     /// Row of `Node::bounds` holding the near plane per axis (by sign bit).
-    pub(crate) near: [usize; 3],
+    pub(crate) near: [u8; 3],
     /// Row holding the far plane per axis.
-    pub(crate) far: [usize; 3],
-    /// `1 ± 2γ(3)`: far distances are widened outward by rounding bounds.
-    pub(crate) far_up: F32x4,
-    pub(crate) far_down: F32x4,
-    pub(crate) t_min: F32x4,
+    pub(crate) far: [u8; 3],
     /// Watertight shear constants for triangles.
     pub(crate) wt: WatertightRay,
-    /// Origin permuted to `[kx, ky, kz]`, splatted.
-    pub(crate) wt_org: [F32x4; 3],
-    /// `(Sx, Sy, Sz)` splatted.
-    pub(crate) wt_shear: [F32x4; 3],
+    /// Origin permuted to `[kx, ky, kz]`.
+    pub(crate) wt_org: glam::Vec3,
 }
 
 impl RayCtx {
@@ -47,9 +36,8 @@ impl RayCtx {
         }
         let o = ray.origin;
         let d = ray.direction;
-        let inv = d.recip();
-        let sel = |a: usize| {
-            let neg = usize::from(d[a].is_sign_negative());
+        let sel = |a: u8| {
+            let neg = u8::from(d[usize::from(a)].is_sign_negative());
             (2 * a + neg, 2 * a + 1 - neg)
         };
         let (nx, fx) = sel(0);
@@ -59,22 +47,24 @@ impl RayCtx {
         let [kx, ky, kz] = wt.axes;
         Some(Self {
             ray: *ray,
-            inv1: inv,
-            org: [F32x4::splat(o.x), F32x4::splat(o.y), F32x4::splat(o.z)],
-            inv: [F32x4::splat(inv.x), F32x4::splat(inv.y), F32x4::splat(inv.z)],
+            inv1: d.recip(),
             near: [nx, ny, nz],
             far: [fx, fy, fz],
-            far_up: F32x4::splat(SLAB_FAR_SCALE),
-            far_down: F32x4::splat(SLAB_FAR_SCALE_NEG),
-            t_min: F32x4::splat(ray.t_min),
             wt,
-            wt_org: [F32x4::splat(o[kx]), F32x4::splat(o[ky]), F32x4::splat(o[kz])],
-            wt_shear: [
-                F32x4::splat(wt.shear.x),
-                F32x4::splat(wt.shear.y),
-                F32x4::splat(wt.shear.z),
-            ],
+            wt_org: glam::Vec3::new(o[kx], o[ky], o[kz]),
         })
+    }
+
+    /// The origin per axis, splatted.
+    #[inline(always)]
+    pub(crate) fn org4(&self, a: usize) -> F32x4 {
+        F32x4::splat(self.ray.origin[a])
+    }
+
+    /// The reciprocal direction per axis, splatted.
+    #[inline(always)]
+    pub(crate) fn inv4(&self, a: usize) -> F32x4 {
+        F32x4::splat(self.inv1[a])
     }
 
     /// [`rt_core::Aabb::admits_hit`] for the box `lo..hi` and this ray,
@@ -104,10 +94,11 @@ impl RayCtx {
     /// The near and far plane rows of `bounds` (a node's) for axis `a`.
     #[inline(always)]
     pub(crate) fn planes<'b, T>(&self, bounds: &'b [T; 6], a: usize) -> (&'b T, &'b T) {
-        debug_assert!(self.near[a] < 6 && self.far[a] < 6);
+        let (near, far) = (usize::from(self.near[a]), usize::from(self.far[a]));
+        debug_assert!(near < 6 && far < 6);
         // SAFETY: `RayCtx::new`, the only constructor, sets every `near`
         // and `far` entry to `2·axis` or `2·axis + 1` with `axis < 3`.
-        unsafe { (bounds.get_unchecked(self.near[a]), bounds.get_unchecked(self.far[a])) }
+        unsafe { (bounds.get_unchecked(near), bounds.get_unchecked(far)) }
     }
 
     /// The ray these constants were made for.

@@ -495,6 +495,7 @@ pub(crate) fn box_test<const AVX: bool>(
 #[inline(always)]
 fn box_test_x4(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
     use crate::simd::F32x4;
+    use rt_core::internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG};
     let b = &node.bounds;
     let t_max = F32x4::splat(t_max);
     let mut mask = 0;
@@ -502,21 +503,22 @@ fn box_test_x4(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
     for g in 0..GROUPS {
         let slab = |a: usize| {
             let (near, far) = ctx.planes(b, a);
-            let near = F32x4::from_array(near[g]).sub(ctx.org[a]).mul(ctx.inv[a]);
-            let far = F32x4::from_array(far[g]).sub(ctx.org[a]).mul(ctx.inv[a]);
+            let near = F32x4::from_array(near[g]).sub(ctx.org4(a)).mul(ctx.inv4(a));
+            let far = F32x4::from_array(far[g]).sub(ctx.org4(a)).mul(ctx.inv4(a));
             (near, far)
         };
         let (nx, fx) = slab(0);
         let (ny, fy) = slab(1);
         let (nz, fz) = slab(2);
         // `x.max(acc)` keeps `acc` when `x` is NaN (a ray in a slab plane).
-        let t0 = nx.max(ny.max(nz.max(ctx.t_min)));
+        let t0 = nx.max(ny.max(nz.max(F32x4::splat(ctx.ray.t_min))));
         let inf = F32x4::splat(f32::INFINITY);
         let t1 = fx.min(fy.min(fz.min(inf)));
         // Widen outward whatever the sign (rt_core::internal::widen_far):
         // `t0 ≤ min(max(t1·up, t1·down), t_max)` as three compares (no
         // value is NaN), as the AVX kernels do.
-        let (up, down) = (t1.mul(ctx.far_up), t1.mul(ctx.far_down));
+        let (up, down) =
+            (t1.mul(F32x4::splat(SLAB_FAR_SCALE)), t1.mul(F32x4::splat(SLAB_FAR_SCALE_NEG)));
         let m = (t0.le_mask(up) | t0.le_mask(down)) & t0.le_mask(t_max);
         mask |= m << (4 * g);
         tnear[4 * g..4 * g + 4].copy_from_slice(&t0.to_array());

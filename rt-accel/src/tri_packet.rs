@@ -87,8 +87,8 @@ impl TriPacket {
     #[inline(always)]
     fn lanes(&self, ctx: &RayCtx, t_max: F32x4) -> (u32, u32, [f32; 4]) {
         let [kx, ky, kz] = ctx.wt.axes;
-        let [ox, oy, oz] = ctx.wt_org;
-        let [sx, sy, sz] = ctx.wt_shear;
+        let [ox, oy, oz] = ctx.wt_org.to_array().map(F32x4::splat);
+        let [sx, sy, sz] = ctx.wt.shear.to_array().map(F32x4::splat);
         let vert = |k: usize| {
             let p = &self.v[k];
             let x = F32x4::from_array(p[kx]).sub(ox);
@@ -111,7 +111,7 @@ impl TriPacket {
         let t = tt.mul(F32x4::splat(1.0).div(det));
         let inf = F32x4::splat(f32::INFINITY);
         // `t < ∞` as the scalar test: an overflowed `t` is no hit.
-        let in_range = ctx.t_min.le_mask(t) & t.le_mask(t_max) & t.lt_mask(inf);
+        let in_range = F32x4::splat(ctx.ray.t_min).le_mask(t) & t.le_mask(t_max) & t.lt_mask(inf);
         // As the scalar test: an overflowed `det` is no hit.
         let finite = det.lt_mask(inf) & F32x4::splat(f32::NEG_INFINITY).lt_mask(det);
         let ok = !(neg & pos) & !det.eq_mask(zero) & finite & in_range & !on_edge & 0xf;
