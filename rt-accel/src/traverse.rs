@@ -233,13 +233,15 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 // `t_max` (found by the `bvh` fuzz target with
                 // `t_min = t_max`).
                 let (mask, _) = box_test::<AVX>(node, ctx, widen_far(t_max));
-                // Empty slots are never entered (see `closest_step`).
-                let mut m = mask;
-                while m != 0 {
-                    let i = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    stack[sp].write(node.children[i]);
-                    sp += 1;
+                // Empty slots are never entered (see `closest_step`). The
+                // hit children are pushed in slot order and the last one
+                // is visited next, taken from the node rather than
+                // reloaded from the store just made.
+                if mask != 0 {
+                    push_children::<AVX>(stack, sp, node, mask);
+                    sp += mask.count_ones() as usize - 1;
+                    cur = node.children[31 - mask.leading_zeros() as usize];
+                    continue;
                 }
             }
             if sp == 0 {
@@ -470,6 +472,81 @@ pub(crate) struct Walk {
     pub(crate) cur: ChildRef,
     pub(crate) sp: usize,
     pub(crate) best: BestHit,
+}
+
+/// Writes the children of `node` named by `mask` (not 0) to
+/// `stack[sp..]` in slot order. The entry for the last may be written or
+/// not (the caller visits it next); with `AVX` entries up to
+/// `sp + WIDTH` are (garbage past the children).
+#[inline(always)]
+fn push_children<const AVX: bool>(
+    stack: &mut [MaybeUninit<ChildRef>; STACK_SIZE],
+    sp: usize,
+    node: &Node,
+    mask: u32,
+) {
+    // Each level leaves at most `WIDTH − 1` entries and `validate` bounds
+    // the depth by `MAX_DEPTH`, so a node is reached with `sp ≤ (WIDTH −
+    // 1)·(MAX_DEPTH − 1)` and the second test always holds.
+    #[cfg(target_arch = "x86_64")]
+    if AVX && sp + WIDTH <= STACK_SIZE {
+        // SAFETY: `AVX` kernels run only where the CPU has AVX2 (see
+        // `box_test`); the `WIDTH` entries from `sp` lie in the stack.
+        unsafe { push_hit_children(stack.as_mut_ptr().add(sp), node, mask) };
+        return;
+    }
+    let (mut m, mut k) = (mask, sp);
+    while m != 0 {
+        let i = m.trailing_zeros() as usize;
+        m &= m - 1;
+        stack[k].write(node.children[i]);
+        k += 1;
+    }
+}
+
+/// For each 8-bit child mask, the slots of its set bits in order, padded
+/// with slot 0: the permutation that packs a node's hit children together.
+#[cfg(target_arch = "x86_64")]
+static COMPRESS: [[u32; WIDTH]; 1 << WIDTH] = {
+    let mut t = [[0u32; WIDTH]; 1 << WIDTH];
+    let mut m = 0;
+    while m < 1 << WIDTH {
+        let (mut k, mut i) = (0, 0);
+        while i < WIDTH {
+            if m & (1 << i) != 0 {
+                t[m][k] = i as u32;
+                k += 1;
+            }
+            i += 1;
+        }
+        m += 1;
+    }
+    t
+};
+
+/// Writes the children of `node` named by `mask` to `out[0..popcount]`
+/// in slot order, with one 8-lane permute and store and no branch (the
+/// loop over set bits mispredicted its exit at every node). All `WIDTH`
+/// entries of `out` are written; those past the count are garbage.
+///
+/// # Safety
+/// The CPU must have AVX2, and `out` must be valid for `WIDTH` writes.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn push_hit_children(out: *mut MaybeUninit<ChildRef>, node: &Node, mask: u32) {
+    use core::arch::x86_64::{
+        __m256i, _mm256_loadu_si256, _mm256_permutevar8x32_epi32, _mm256_storeu_si256,
+    };
+    debug_assert!(mask < 1 << WIDTH);
+    // SAFETY: the caller guarantees AVX2 and `out`; `node.children` is
+    // `WIDTH` u32s (32 bytes, read unaligned); `mask & 0xff` indexes the
+    // table.
+    unsafe {
+        let kids = _mm256_loadu_si256(node.children.as_ptr().cast::<__m256i>());
+        let perm = COMPRESS.get_unchecked((mask & 0xff) as usize);
+        let perm = _mm256_loadu_si256(perm.as_ptr().cast::<__m256i>());
+        _mm256_storeu_si256(out.cast::<__m256i>(), _mm256_permutevar8x32_epi32(kids, perm));
+    }
 }
 
 /// The node test of kernel `AVX` (see [`box_test_avx`]) or the 4-wide one.
