@@ -211,6 +211,37 @@ mod avx {
         pub(crate) unsafe fn le_mask(self, o: Self) -> u32 {
             (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) }) as u32
         }
+        /// All ones in the lanes where `self <= o` (none for NaN), else 0.
+        #[inline(always)]
+        pub(crate) unsafe fn le(self, o: Self) -> Self {
+            Self(unsafe { _mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0) })
+        }
+        /// Bitwise or.
+        #[inline(always)]
+        pub(crate) unsafe fn or(self, o: Self) -> Self {
+            Self(unsafe { _mm256_or_ps(self.0, o.0) })
+        }
+        /// Bitwise and.
+        #[inline(always)]
+        pub(crate) unsafe fn and(self, o: Self) -> Self {
+            Self(unsafe { _mm256_and_ps(self.0, o.0) })
+        }
+        /// Every lane holding the bits of `bits` (not a float value: for
+        /// [`F32x8::and`] / [`F32x8::or`] and [`F32x8::to_bits`]).
+        #[inline(always)]
+        pub(crate) unsafe fn splat_bits(bits: u32) -> Self {
+            Self(unsafe { _mm256_castsi256_ps(_mm256_set1_epi32(bits as i32)) })
+        }
+        /// The lanes' bits.
+        #[inline(always)]
+        pub(crate) fn to_bits(self) -> [u32; 8] {
+            bytemuck::cast(self.0)
+        }
+        /// Bit `i` set where lane `i`'s sign bit is.
+        #[inline(always)]
+        pub(crate) unsafe fn sign_mask(self) -> u32 {
+            (unsafe { _mm256_movemask_ps(self.0) }) as u32
+        }
     }
 }
 

@@ -20,7 +20,7 @@ use rt_core::{Ray, internal::widen_far};
 
 use crate::{
     Isa, RayCtx,
-    node::{ChildRef, WIDTH},
+    node::{ChildRef, Node, WIDTH},
     prim::{BestHit, Primitive},
     traverse::{BvhRef, STACK_SIZE, TraversalStack, TraversalStats, Walk, box_test},
 };
@@ -219,20 +219,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                 } else {
                     let node = self.node(cur);
                     // The rays entering each child.
-                    let mut child = [0u32; WIDTH];
-                    let mut m = active;
-                    while m != 0 {
-                        let r = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        let ctx = &ctxs[r];
-                        // Widened as in the single-ray occlusion test.
-                        let (hit, _) = box_test::<AVX>(node, ctx, widen_far(ctx.ray.t_max));
-                        // Branch-free: which children a ray enters is
-                        // unpredictable.
-                        for (i, c) in child.iter_mut().enumerate() {
-                            *c |= (hit >> i & 1) << r;
-                        }
-                    }
+                    let child = group_box_test::<AVX>(node, ctxs, active);
                     for i in (0..WIDTH).rev() {
                         if child[i] != 0 {
                             stack.0[sp] = (node.children[i], child[i]);
@@ -248,6 +235,47 @@ impl<P: Primitive> BvhRef<'_, P> {
             (cur, rays) = stack.0[sp];
         }
     }
+}
+
+/// Which of the rays in `active` (bits of `ctxs`) enter each child of
+/// `node`, each ray tested with the single-ray occlusion test. The AVX
+/// kernels gather the rays' bits with two vector operations per ray; the
+/// 4-wide one bit by bit. Branch-free: which children a ray enters is
+/// unpredictable.
+#[inline(always)]
+fn group_box_test<const AVX: bool>(node: &Node, ctxs: &[RayCtx], active: u32) -> [u32; WIDTH] {
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        use crate::{simd::F32x8, traverse::box_lanes_avx};
+        // SAFETY: `AVX` kernels run only where the CPU has AVX2 (see
+        // `box_test`).
+        return unsafe {
+            let mut acc = F32x8::splat_bits(0);
+            let mut m = active;
+            while m != 0 {
+                let r = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let ctx = &ctxs[r];
+                // Widened as in the single-ray occlusion test.
+                let (entered, _) = box_lanes_avx(node, ctx, widen_far(ctx.ray.t_max));
+                acc = acc.or(entered.and(F32x8::splat_bits(1 << r)));
+            }
+            acc.to_bits()
+        };
+    }
+    let mut child = [0u32; WIDTH];
+    let mut m = active;
+    while m != 0 {
+        let r = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let ctx = &ctxs[r];
+        // Widened as in the single-ray occlusion test.
+        let (hit, _) = box_test::<AVX>(node, ctx, widen_far(ctx.ray.t_max));
+        for (i, c) in child.iter_mut().enumerate() {
+            *c |= (hit >> i & 1) << r;
+        }
+    }
+    child
 }
 
 /// Rays an occlusion stream walks the tree with together (bits of a `u32`).

@@ -611,6 +611,25 @@ fn box_test_x4(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn box_test_avx(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
+    // SAFETY: the caller guarantees AVX.
+    unsafe {
+        let (entered, t0) = box_lanes_avx(node, ctx, t_max);
+        (entered.sign_mask(), t0.to_array())
+    }
+}
+
+/// [`box_test_avx`] as lanes: all ones in the lanes of the boxes entered,
+/// and the entry distances.
+///
+/// # Safety
+/// The CPU must have AVX. Always inlined, into the kernels compiled with it.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) unsafe fn box_lanes_avx(
+    node: &Node,
+    ctx: &RayCtx,
+    t_max: f32,
+) -> (crate::simd::F32x8, crate::simd::F32x8) {
     use crate::simd::F32x8;
     use rt_core::internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG};
     const { assert!(GROUPS == 2) };
@@ -640,8 +659,8 @@ unsafe fn box_test_avx(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WID
         // side (none of the values is NaN: the same mask, a shorter chain).
         let up = t1.mul(F32x8::splat(SLAB_FAR_SCALE));
         let down = t1.mul(F32x8::splat(SLAB_FAR_SCALE_NEG));
-        let mask = (t0.le_mask(up) | t0.le_mask(down)) & t0.le_mask(F32x8::splat(t_max));
-        (mask, t0.to_array())
+        let entered = t0.le(up).or(t0.le(down)).and(t0.le(F32x8::splat(t_max)));
+        (entered, t0)
     }
 }
 
