@@ -359,8 +359,13 @@ impl<P: Primitive> BvhRef<'_, P> {
                     bits &= bits - 1;
                     if let Some(ctx) = &l.ctx[r] {
                         let mut stats = TraversalStats::default();
-                        best[r] =
-                            self.closest_from::<AVX>(ctx, cur, best[r], &mut stats, &mut single);
+                        best[r] = self.closest_from::<AVX, false>(
+                            ctx,
+                            cur,
+                            best[r],
+                            &mut stats,
+                            &mut single,
+                        );
                     }
                 }
             } else if cur.is_leaf() {
@@ -432,7 +437,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                     let r = bits.trailing_zeros() as usize;
                     bits &= bits - 1;
                     if let Some(ctx) = &l.ctx[r]
-                        && self.occluded_from::<AVX>(ctx, cur, &mut single)
+                        && self.occluded_from::<AVX, false>(ctx, cur, &mut single)
                     {
                         done |= 1 << r;
                     }

@@ -106,7 +106,7 @@ impl<P: Primitive> BvhRef<'_, P> {
             for (lane, stack) in lanes.iter_mut().zip(&mut stacks) {
                 let Some(l) = lane else { continue };
                 live = true;
-                if !self.closest_step::<AVX>(&l.ctx, &mut l.walk, &mut stats, stack) {
+                if !self.closest_step::<AVX, false>(&l.ctx, &mut l.walk, &mut stats, stack) {
                     let best = l.walk.best;
                     out(l.index, best.is_hit().then_some(best));
                     *lane = next_lane(rays, &mut next, |i| out(i, None));
@@ -257,7 +257,7 @@ fn group_box_test<const AVX: bool>(node: &Node, ctxs: &[RayCtx], active: u32) ->
                 m &= m - 1;
                 let ctx = &ctxs[r];
                 // Widened as in the single-ray occlusion test.
-                let (entered, _) = box_lanes_avx(node, ctx, widen_far(ctx.ray.t_max));
+                let (entered, _) = box_lanes_avx::<false>(node, ctx, widen_far(ctx.ray.t_max));
                 acc = acc.or(entered.and(F32x8::splat_bits(1 << r)));
             }
             acc.to_bits()
@@ -270,7 +270,7 @@ fn group_box_test<const AVX: bool>(node: &Node, ctxs: &[RayCtx], active: u32) ->
         m &= m - 1;
         let ctx = &ctxs[r];
         // Widened as in the single-ray occlusion test.
-        let (hit, _) = box_test::<AVX>(node, ctx, widen_far(ctx.ray.t_max));
+        let (hit, _) = box_test::<AVX, false>(node, ctx, widen_far(ctx.ray.t_max));
         for (i, c) in child.iter_mut().enumerate() {
             *c |= (hit >> i & 1) << r;
         }

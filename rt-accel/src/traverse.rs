@@ -180,35 +180,48 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
             Isa::Avx2 => unsafe { self.occluded_avx2(&ctx, stack) },
-            _ => self.occluded_kernel::<false>(&ctx, stack),
+            _ if ctx.ray.t_min >= 0.0 => self.occluded_kernel::<false, true>(&ctx, stack),
+            _ => self.occluded_kernel::<false, false>(&ctx, stack),
         }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
     fn occluded_avx2(&self, ctx: &RayCtx, stack: &mut TraversalStack) -> bool {
-        self.occluded_kernel::<true>(ctx, stack)
+        if ctx.ray.t_min >= 0.0 {
+            self.occluded_kernel::<true, true>(ctx, stack)
+        } else {
+            self.occluded_kernel::<true, false>(ctx, stack)
+        }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
     fn occluded_avx512(&self, ctx: &RayCtx, stack: &mut TraversalStack) -> bool {
-        self.occluded_kernel::<true>(ctx, stack)
+        if ctx.ray.t_min >= 0.0 {
+            self.occluded_kernel::<true, true>(ctx, stack)
+        } else {
+            self.occluded_kernel::<true, false>(ctx, stack)
+        }
     }
 
     /// The occlusion kernel: any hit ends it. `AVX`: test a node's boxes
     /// in one 8-wide pass (only inside the AVX kernels above).
     #[inline(always)]
-    fn occluded_kernel<const AVX: bool>(&self, ctx: &RayCtx, stack: &mut TraversalStack) -> bool {
+    fn occluded_kernel<const AVX: bool, const NONNEG: bool>(
+        &self,
+        ctx: &RayCtx,
+        stack: &mut TraversalStack,
+    ) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        self.occluded_from::<AVX>(ctx, ChildRef::inner(0), stack)
+        self.occluded_from::<AVX, NONNEG>(ctx, ChildRef::inner(0), stack)
     }
 
     /// [`Self::occluded_kernel`] over the subtree `start` only.
     #[inline(always)]
-    pub(crate) fn occluded_from<const AVX: bool>(
+    pub(crate) fn occluded_from<const AVX: bool, const NONNEG: bool>(
         &self,
         ctx: &RayCtx,
         start: ChildRef,
@@ -232,7 +245,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 // distance just past `t_max` may hold a hit at exactly
                 // `t_max` (found by the `bvh` fuzz target with
                 // `t_min = t_max`).
-                let (mask, _) = box_test::<AVX>(node, ctx, widen_far(t_max));
+                let (mask, _) = box_test::<AVX, NONNEG>(node, ctx, widen_far(t_max));
                 // Empty slots are never entered (see `closest_step`). The
                 // hit children are pushed in slot order and the last one
                 // is visited next, taken from the node rather than
@@ -302,7 +315,8 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
             Isa::Avx2 => unsafe { self.closest_avx2(ctx, stats, stack) },
-            _ => self.closest_kernel::<false>(ctx, stats, stack),
+            _ if ctx.ray.t_min >= 0.0 => self.closest_kernel::<false, true>(ctx, stats, stack),
+            _ => self.closest_kernel::<false, false>(ctx, stats, stack),
         }
     }
 
@@ -314,7 +328,11 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         stats: &mut TraversalStats,
         stack: &mut TraversalStack,
     ) -> BestHit {
-        self.closest_kernel::<true>(ctx, stats, stack)
+        if ctx.ray.t_min >= 0.0 {
+            self.closest_kernel::<true, true>(ctx, stats, stack)
+        } else {
+            self.closest_kernel::<true, false>(ctx, stats, stack)
+        }
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -325,14 +343,18 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         stats: &mut TraversalStats,
         stack: &mut TraversalStack,
     ) -> BestHit {
-        self.closest_kernel::<true>(ctx, stats, stack)
+        if ctx.ray.t_min >= 0.0 {
+            self.closest_kernel::<true, true>(ctx, stats, stack)
+        } else {
+            self.closest_kernel::<true, false>(ctx, stats, stack)
+        }
     }
 
     /// The traversal kernel: front-to-back by entry distance, culling
     /// stacked subtrees that start beyond the best hit. `AVX`: test a
     /// node's boxes in one 8-wide pass (only inside the AVX kernels above).
     #[inline(always)]
-    fn closest_kernel<const AVX: bool>(
+    fn closest_kernel<const AVX: bool, const NONNEG: bool>(
         &self,
         ctx: &RayCtx,
         stats: &mut TraversalStats,
@@ -342,14 +364,14 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         if self.nodes.is_empty() {
             return best;
         }
-        self.closest_from::<AVX>(ctx, ChildRef::inner(0), best, stats, stack)
+        self.closest_from::<AVX, NONNEG>(ctx, ChildRef::inner(0), best, stats, stack)
     }
 
     /// [`Self::closest_kernel`] over the subtree `start` only, improving
     /// on `best` (the packets hand a subtree to it once a single ray is
     /// left in it).
     #[inline(always)]
-    pub(crate) fn closest_from<const AVX: bool>(
+    pub(crate) fn closest_from<const AVX: bool, const NONNEG: bool>(
         &self,
         ctx: &RayCtx,
         start: ChildRef,
@@ -358,7 +380,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         stack: &mut TraversalStack,
     ) -> BestHit {
         let mut walk = Walk { cur: start, sp: 0, best };
-        while self.closest_step::<AVX>(ctx, &mut walk, stats, stack) {}
+        while self.closest_step::<AVX, NONNEG>(ctx, &mut walk, stats, stack) {}
         walk.best
     }
 
@@ -367,7 +389,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     /// entry distance, skipping stacked subtrees that start beyond the
     /// best hit. False when nothing is left to visit.
     #[inline(always)]
-    pub(crate) fn closest_step<const AVX: bool>(
+    pub(crate) fn closest_step<const AVX: bool, const NONNEG: bool>(
         &self,
         ctx: &RayCtx,
         walk: &mut Walk,
@@ -389,7 +411,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             // may still hold an exact tie; widen the bound as the far
             // planes are widened.
             let bound = widen_far(best.t);
-            let (mask, tnear) = box_test::<AVX>(node, ctx, bound);
+            let (mask, tnear) = box_test::<AVX, NONNEG>(node, ctx, bound);
             // Empty slots hold the empty box, which no ray enters
             // (`validate` rejects blobs where they do not): `mask` names
             // real children only. One or two children (most nodes) take
@@ -550,8 +572,19 @@ unsafe fn push_hit_children(out: *mut MaybeUninit<ChildRef>, node: &Node, mask: 
 }
 
 /// The node test of kernel `AVX` (see [`box_test_avx`]) or the 4-wide one.
+///
+/// `NONNEG`: the ray has `t_min ≥ 0` (the single-ray kernels pick it per
+/// ray), and the test skips comparing the entry distance `t0` with the
+/// far distance widened downward, `t1·(1 − 2γ₃)`, which only matters for
+/// negative distances. With `t_min ≥ 0`, `t0 ≥ 0`: if `t1 ≥ 0`, then
+/// `t1·(1 − 2γ₃) ≤ t1·(1 + 2γ₃)`, so that comparison holds only where the
+/// upward one does; if `t1 < 0`, the product is negative too (rounding
+/// cannot take a nonzero product of magnitude above half the smallest
+/// subnormal to 0) and `t0` is not below it; `t1 = −0` gives the same
+/// product both ways. The mask is the same bit for bit, one multiply, one
+/// compare and one `or` cheaper (+3–4 % on every single-ray row here).
 #[inline(always)]
-pub(crate) fn box_test<const AVX: bool>(
+pub(crate) fn box_test<const AVX: bool, const NONNEG: bool>(
     node: &Node,
     ctx: &RayCtx,
     t_max: f32,
@@ -561,16 +594,16 @@ pub(crate) fn box_test<const AVX: bool>(
         // SAFETY: `AVX` kernels are instantiated only inside the functions
         // compiled with AVX enabled (`closest_avx2`, …), which are called
         // only when `Isa::is_available` found the CPU has it.
-        return unsafe { box_test_avx(node, ctx, t_max) };
+        return unsafe { box_test_avx::<NONNEG>(node, ctx, t_max) };
     }
-    box_test_x4(node, ctx, t_max)
+    box_test_x4::<NONNEG>(node, ctx, t_max)
 }
 
 /// Tests the ray against a node's boxes (Ize 2013's robust slab test, see
 /// [`rt_core::Aabb::intersect_ray`]), four per 4-wide pass. Returns the
 /// mask of boxes entered within `[t_min, t_max]` and the entry distances.
 #[inline(always)]
-fn box_test_x4(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
+fn box_test_x4<const NONNEG: bool>(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
     use crate::simd::F32x4;
     use rt_core::internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG};
     let b = &node.bounds;
@@ -596,7 +629,8 @@ fn box_test_x4(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
         // value is NaN), as the AVX kernels do.
         let (up, down) =
             (t1.mul(F32x4::splat(SLAB_FAR_SCALE)), t1.mul(F32x4::splat(SLAB_FAR_SCALE_NEG)));
-        let m = (t0.le_mask(up) | t0.le_mask(down)) & t0.le_mask(t_max);
+        let far = if NONNEG { t0.le_mask(up) } else { t0.le_mask(up) | t0.le_mask(down) };
+        let m = far & t0.le_mask(t_max);
         mask |= m << (4 * g);
         tnear[4 * g..4 * g + 4].copy_from_slice(&t0.to_array());
     }
@@ -610,10 +644,14 @@ fn box_test_x4(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
 /// The CPU must have AVX. Always inlined, into the kernels compiled with it.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn box_test_avx(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
+unsafe fn box_test_avx<const NONNEG: bool>(
+    node: &Node,
+    ctx: &RayCtx,
+    t_max: f32,
+) -> (u32, [f32; WIDTH]) {
     // SAFETY: the caller guarantees AVX.
     unsafe {
-        let (entered, t0) = box_lanes_avx(node, ctx, t_max);
+        let (entered, t0) = box_lanes_avx::<NONNEG>(node, ctx, t_max);
         (entered.sign_mask(), t0.to_array())
     }
 }
@@ -625,7 +663,7 @@ unsafe fn box_test_avx(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WID
 /// The CPU must have AVX. Always inlined, into the kernels compiled with it.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-pub(crate) unsafe fn box_lanes_avx(
+pub(crate) unsafe fn box_lanes_avx<const NONNEG: bool>(
     node: &Node,
     ctx: &RayCtx,
     t_max: f32,
@@ -659,7 +697,8 @@ pub(crate) unsafe fn box_lanes_avx(
         // side (none of the values is NaN: the same mask, a shorter chain).
         let up = t1.mul(F32x8::splat(SLAB_FAR_SCALE));
         let down = t1.mul(F32x8::splat(SLAB_FAR_SCALE_NEG));
-        let entered = t0.le(up).or(t0.le(down)).and(t0.le(F32x8::splat(t_max)));
+        let far = if NONNEG { t0.le(up) } else { t0.le(up).or(t0.le(down)) };
+        let entered = far.and(t0.le(F32x8::splat(t_max)));
         (entered, t0)
     }
 }

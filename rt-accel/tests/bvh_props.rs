@@ -38,7 +38,9 @@ fn soup() -> impl Strategy<Value = (Vec<Vec3>, Vec<[u32; 3]>)> {
 }
 
 fn ray() -> impl Strategy<Value = Ray> {
-    (vec3(14.0), vec3(1.0), 0.0f32..2.0, prop::bool::ANY).prop_filter_map(
+    // Negative `t_min` too: the single-ray kernels test such rays with the
+    // full far-plane comparison, the others with a shorter one.
+    (vec3(14.0), vec3(1.0), -2.0f32..2.0, prop::bool::ANY).prop_filter_map(
         "zero dir",
         |(o, d, tmin, inf)| {
             if d.length_squared() < 1e-6 {
@@ -224,6 +226,36 @@ proptest! {
         // And the refit tree is still well formed.
         prop_assert!(Bvh::<TriPacket>::from_bytes(&bvh.to_bytes()).is_ok());
     }
+}
+
+#[test]
+fn a_flat_triangle_behind_the_origin_is_hit_with_negative_t_min() {
+    // A triangle in the plane z = 0 and rays leaving it toward +z with
+    // `t_min < 0`: the hit is at t = −1, where the flat box's entry and
+    // exit distances are equal and negative. Only the far distance widened
+    // toward zero admits the box (the kernels for `t_min ≥ 0` skip that
+    // comparison, which must never be used for these rays).
+    let pos = [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+    let bvh = build_triangles(&pos, &[[0, 1, 2]], &params()).unwrap();
+    let rays: Vec<Ray> = (0..8)
+        .map(|i| Ray::with_range(Vec3::new(0.05 * i as f32, 0.1, 1.0), Vec3::Z, -2.0, 5.0))
+        .collect();
+    for isa in Isa::available() {
+        let view = bvh.as_ref().with_isa(isa).unwrap();
+        for r in &rays {
+            let h = view.closest_hit(r).unwrap_or_else(|| panic!("{isa:?}: {r:?} missed"));
+            assert_eq!(h.t, -1.0);
+            assert!(view.occluded(r), "{isa:?}");
+        }
+        let packet = view.closest_t_packet(&rays.clone().try_into().unwrap());
+        assert!(packet.iter().all(|b| b.is_some_and(|b| b.t == -1.0)), "{isa:?}");
+        let mut n = 0;
+        view.occluded_stream(&rays, |_, o| n += usize::from(o));
+        assert_eq!(n, rays.len(), "{isa:?}");
+    }
+    // With `t_min = 0` the triangle is behind the ray: no hit.
+    let r = Ray::with_range(Vec3::new(0.0, 0.1, 1.0), Vec3::Z, 0.0, 5.0);
+    assert!(bvh.closest_hit(&r).is_none() && !bvh.occluded(&r));
 }
 
 #[test]
