@@ -180,43 +180,36 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
             Isa::Avx2 => unsafe { self.occluded_avx2(&ctx, stack) },
-            _ if ctx.ray.t_min >= 0.0 => self.occluded_kernel::<false, true>(&ctx, stack),
-            _ => self.occluded_kernel::<false, false>(&ctx, stack),
+            _ => self.occluded_kernel::<false>(&ctx, stack),
         }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
     fn occluded_avx2(&self, ctx: &RayCtx, stack: &mut TraversalStack) -> bool {
-        if ctx.ray.t_min >= 0.0 {
-            self.occluded_kernel::<true, true>(ctx, stack)
-        } else {
-            self.occluded_kernel::<true, false>(ctx, stack)
-        }
+        self.occluded_kernel::<true>(ctx, stack)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
     fn occluded_avx512(&self, ctx: &RayCtx, stack: &mut TraversalStack) -> bool {
-        if ctx.ray.t_min >= 0.0 {
-            self.occluded_kernel::<true, true>(ctx, stack)
-        } else {
-            self.occluded_kernel::<true, false>(ctx, stack)
-        }
+        self.occluded_kernel::<true>(ctx, stack)
     }
 
     /// The occlusion kernel: any hit ends it. `AVX`: test a node's boxes
-    /// in one 8-wide pass (only inside the AVX kernels above).
+    /// in one 8-wide pass (only inside the AVX kernels above). Rays with
+    /// `t_min ≥ 0` take the shorter box test (see [`box_test`]).
     #[inline(always)]
-    fn occluded_kernel<const AVX: bool, const NONNEG: bool>(
-        &self,
-        ctx: &RayCtx,
-        stack: &mut TraversalStack,
-    ) -> bool {
+    fn occluded_kernel<const AVX: bool>(&self, ctx: &RayCtx, stack: &mut TraversalStack) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        self.occluded_from::<AVX, NONNEG>(ctx, ChildRef::inner(0), stack)
+        let root = ChildRef::inner(0);
+        if ctx.ray.t_min >= 0.0 {
+            self.occluded_from::<AVX, true>(ctx, root, stack)
+        } else {
+            self.occluded_from::<AVX, false>(ctx, root, stack)
+        }
     }
 
     /// [`Self::occluded_kernel`] over the subtree `start` only.
@@ -315,8 +308,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
             Isa::Avx2 => unsafe { self.closest_avx2(ctx, stats, stack) },
-            _ if ctx.ray.t_min >= 0.0 => self.closest_kernel::<false, true>(ctx, stats, stack),
-            _ => self.closest_kernel::<false, false>(ctx, stats, stack),
+            _ => self.closest_kernel::<false>(ctx, stats, stack),
         }
     }
 
@@ -328,11 +320,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         stats: &mut TraversalStats,
         stack: &mut TraversalStack,
     ) -> BestHit {
-        if ctx.ray.t_min >= 0.0 {
-            self.closest_kernel::<true, true>(ctx, stats, stack)
-        } else {
-            self.closest_kernel::<true, false>(ctx, stats, stack)
-        }
+        self.closest_kernel::<true>(ctx, stats, stack)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -343,18 +331,15 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         stats: &mut TraversalStats,
         stack: &mut TraversalStack,
     ) -> BestHit {
-        if ctx.ray.t_min >= 0.0 {
-            self.closest_kernel::<true, true>(ctx, stats, stack)
-        } else {
-            self.closest_kernel::<true, false>(ctx, stats, stack)
-        }
+        self.closest_kernel::<true>(ctx, stats, stack)
     }
 
     /// The traversal kernel: front-to-back by entry distance, culling
     /// stacked subtrees that start beyond the best hit. `AVX`: test a
     /// node's boxes in one 8-wide pass (only inside the AVX kernels above).
+    /// Rays with `t_min ≥ 0` take the shorter box test (see [`box_test`]).
     #[inline(always)]
-    fn closest_kernel<const AVX: bool, const NONNEG: bool>(
+    fn closest_kernel<const AVX: bool>(
         &self,
         ctx: &RayCtx,
         stats: &mut TraversalStats,
@@ -364,7 +349,12 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         if self.nodes.is_empty() {
             return best;
         }
-        self.closest_from::<AVX, NONNEG>(ctx, ChildRef::inner(0), best, stats, stack)
+        let root = ChildRef::inner(0);
+        if ctx.ray.t_min >= 0.0 {
+            self.closest_from::<AVX, true>(ctx, root, best, stats, stack)
+        } else {
+            self.closest_from::<AVX, false>(ctx, root, best, stats, stack)
+        }
     }
 
     /// [`Self::closest_kernel`] over the subtree `start` only, improving
