@@ -27,8 +27,9 @@ pub struct RayCtx {
 
 impl RayCtx {
     /// The constants for `ray`, or `None` if the ray is not valid
-    /// ([`Ray::is_valid`]): such rays miss everything.
-    #[inline]
+    /// ([`Ray::is_valid`]): such rays miss everything. Always inlined, so
+    /// the single-ray kernels keep the constants in registers.
+    #[inline(always)]
     #[must_use]
     pub fn new(ray: &Ray) -> Option<Self> {
         if !ray.is_valid() {
