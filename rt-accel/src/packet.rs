@@ -453,7 +453,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                     bits &= bits - 1;
                     if let Some(ctx) = &l.ctx[r] {
                         let t_max = ctx.ray.t_max;
-                        if self.leaf(first, count).iter().any(|it| it.any(ctx, t_max)) {
+                        if crate::stream::any_hit(self.leaf(first, count), ctx, t_max) {
                             done |= 1 << r;
                         }
                     }
