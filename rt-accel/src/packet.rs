@@ -54,9 +54,15 @@ struct Lanes {
 }
 
 impl Lanes {
+    /// Always inlined into the kernels, which build their lanes
+    /// themselves (see `closest_t_packet`); a plain loop, since
+    /// `each_ref().map(…)` was left out of line.
     #[inline(always)]
     fn new(rays: &[Ray; PACKET]) -> Self {
-        let ctx = rays.each_ref().map(RayCtx::new);
+        let mut ctx = [None; PACKET];
+        for (c, r) in ctx.iter_mut().zip(rays) {
+            *c = RayCtx::new(r);
+        }
         let mut l = Self {
             ctx,
             org: [[0.0; PACKET]; 3],
@@ -179,11 +185,14 @@ struct Stack {
 impl Stack {
     #[inline(always)]
     fn new() -> Self {
-        Self {
-            refs: [MaybeUninit::uninit(); STACK_SIZE],
-            rays: [MaybeUninit::uninit(); STACK_SIZE],
-            ts: [MaybeUninit::uninit(); STACK_SIZE],
-            sp: 0,
+        // Built field by field in place: `Self { refs: [uninit; N], …,
+        // sp: 0 }` compiled to a 4 KB memset of zeros on every packet.
+        let mut s = MaybeUninit::<Self>::uninit();
+        // SAFETY: `sp` is written; every other field is an array of
+        // `MaybeUninit`, for which uninitialized memory is a valid value.
+        unsafe {
+            core::ptr::addr_of_mut!((*s.as_mut_ptr()).sp).write(0);
+            s.assume_init()
         }
     }
 
@@ -279,16 +288,17 @@ impl<P: Primitive> BvhRef<'_, P> {
     /// (e.g. a NaN origin), which miss. No allocation.
     #[must_use]
     pub fn closest_t_packet(&self, rays: &[Ray; PACKET]) -> [Option<BestHit>; PACKET] {
-        let l = Lanes::new(rays);
+        // The kernels build the rays' constants themselves: built here and
+        // read back there at once, they would go through memory.
         let best = match self.isa {
             // SAFETY: `self.isa` passed `Isa::is_available`: the CPU has the
             // features these kernels enable.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => unsafe { self.closest_packet_avx512(&l) },
+            Isa::Avx512 => unsafe { self.closest_packet_avx512(rays) },
             // SAFETY: as above.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => unsafe { self.closest_packet_avx2(&l) },
-            _ => self.closest_packet_kernel::<false>(&l),
+            Isa::Avx2 => unsafe { self.closest_packet_avx2(rays) },
+            _ => self.closest_packet_kernel::<false>(rays),
         };
         core::array::from_fn(|r| best[r].is_hit().then_some(best[r]))
     }
@@ -298,48 +308,48 @@ impl<P: Primitive> BvhRef<'_, P> {
     /// first hit found; the packet when every ray has. No allocation.
     #[must_use]
     pub fn occluded_packet(&self, rays: &[Ray; PACKET]) -> [bool; PACKET] {
-        let l = Lanes::new(rays);
         let hit = match self.isa {
             // SAFETY: as in `closest_t_packet`.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => unsafe { self.occluded_packet_avx512(&l) },
+            Isa::Avx512 => unsafe { self.occluded_packet_avx512(rays) },
             // SAFETY: as in `closest_t_packet`.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => unsafe { self.occluded_packet_avx2(&l) },
-            _ => self.occluded_packet_kernel::<false>(&l),
+            Isa::Avx2 => unsafe { self.occluded_packet_avx2(rays) },
+            _ => self.occluded_packet_kernel::<false>(rays),
         };
         core::array::from_fn(|r| hit & (1 << r) != 0)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
-    fn closest_packet_avx2(&self, l: &Lanes) -> [BestHit; PACKET] {
-        self.closest_packet_kernel::<true>(l)
+    fn closest_packet_avx2(&self, rays: &[Ray; PACKET]) -> [BestHit; PACKET] {
+        self.closest_packet_kernel::<true>(rays)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
-    fn closest_packet_avx512(&self, l: &Lanes) -> [BestHit; PACKET] {
-        self.closest_packet_kernel::<true>(l)
+    fn closest_packet_avx512(&self, rays: &[Ray; PACKET]) -> [BestHit; PACKET] {
+        self.closest_packet_kernel::<true>(rays)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
-    fn occluded_packet_avx2(&self, l: &Lanes) -> u32 {
-        self.occluded_packet_kernel::<true>(l)
+    fn occluded_packet_avx2(&self, rays: &[Ray; PACKET]) -> u32 {
+        self.occluded_packet_kernel::<true>(rays)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
-    fn occluded_packet_avx512(&self, l: &Lanes) -> u32 {
-        self.occluded_packet_kernel::<true>(l)
+    fn occluded_packet_avx512(&self, rays: &[Ray; PACKET]) -> u32 {
+        self.occluded_packet_kernel::<true>(rays)
     }
 
     /// Front to back by the nearest entry distance of the rays that want a
     /// subtree; a popped subtree keeps only the rays whose best hit may
     /// still lie beyond that distance.
     #[inline(always)]
-    fn closest_packet_kernel<const AVX: bool>(&self, l: &Lanes) -> [BestHit; PACKET] {
+    fn closest_packet_kernel<const AVX: bool>(&self, rays: &[Ray; PACKET]) -> [BestHit; PACKET] {
+        let l = &Lanes::new(rays);
         let mut best: [BestHit; PACKET] = core::array::from_fn(|r| {
             BestHit::new(l.ctx[r].as_ref().map_or(f32::NEG_INFINITY, |c| c.ray.t_max))
         });
@@ -418,7 +428,8 @@ impl<P: Primitive> BvhRef<'_, P> {
 
     /// Any hit ends a ray; the packet ends when every ray has.
     #[inline(always)]
-    fn occluded_packet_kernel<const AVX: bool>(&self, l: &Lanes) -> u32 {
+    fn occluded_packet_kernel<const AVX: bool>(&self, rays: &[Ray; PACKET]) -> u32 {
+        let l = &Lanes::new(rays);
         let mut done = 0u32;
         if self.nodes.is_empty() || l.valid == 0 {
             return done;
