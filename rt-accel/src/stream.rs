@@ -245,19 +245,14 @@ impl<P: Primitive> BvhRef<'_, P> {
                     let node = self.node(cur);
                     // The rays entering each child.
                     let child = group_box_test::<AVX, NONNEG>(node, ctxs, active);
-                    for i in (0..WIDTH).rev() {
-                        if child[i] != 0 {
-                            stack.0[sp] = (node.children[i], child[i]);
-                            sp += 1;
-                        }
-                    }
+                    sp = push_group::<AVX>(&mut stack.0, sp, node, &child);
                 }
             }
             if sp == 0 {
                 return occluded;
             }
             sp -= 1;
-            (cur, rays) = stack.0[sp];
+            Entry { node: cur, rays } = stack.0[sp];
         }
     }
 }
@@ -330,10 +325,107 @@ pub const GROUP: usize = 32;
 /// The pending subtrees of a group and the rays that entered each. Each
 /// level leaves at most `WIDTH − 1` siblings pending and pushes at most
 /// `WIDTH`, so `STACK_SIZE` entries hold a tree of `MAX_DEPTH` levels.
-struct GroupStack([(ChildRef, u32); STACK_SIZE]);
+struct GroupStack([Entry; STACK_SIZE]);
 
 impl GroupStack {
     fn new() -> Self {
-        Self([(ChildRef::EMPTY, 0); STACK_SIZE])
+        Self([Entry { node: ChildRef::EMPTY, rays: 0 }; STACK_SIZE])
+    }
+}
+
+/// A pending subtree of a group and the rays that entered it (a `repr(C)`
+/// pair, which [`push_entered`] writes as two 32-bit lanes).
+#[derive(Clone, Copy)]
+#[repr(C)]
+struct Entry {
+    node: ChildRef,
+    rays: u32,
+}
+
+/// Pushes an entry for every child of `node` that some ray entered
+/// (`child[i] != 0`), highest slot first (so the lowest is visited
+/// first); returns the new stack height.
+#[inline(always)]
+fn push_group<const AVX: bool>(
+    stack: &mut [Entry; STACK_SIZE],
+    sp: usize,
+    node: &Node,
+    child: &[u32; WIDTH],
+) -> usize {
+    // Each level leaves at most `WIDTH − 1` entries and the depth is at
+    // most `MAX_DEPTH` (`validate`), so a node is reached with
+    // `sp ≤ (WIDTH − 1)·(MAX_DEPTH − 1)` and the test always holds.
+    #[cfg(target_arch = "x86_64")]
+    if AVX && sp + WIDTH <= STACK_SIZE {
+        // SAFETY: `AVX` kernels run only where the CPU has AVX2; the
+        // `WIDTH` entries from `sp` lie in the stack.
+        return sp + unsafe { push_entered(stack.as_mut_ptr().add(sp), node, child) };
+    }
+    let mut sp = sp;
+    for i in (0..WIDTH).rev() {
+        if child[i] != 0 {
+            stack[sp] = Entry { node: node.children[i], rays: child[i] };
+            sp += 1;
+        }
+    }
+    sp
+}
+
+/// For each 8-bit child mask, the slots of its set bits from the highest
+/// down, padded with slot 0.
+#[cfg(target_arch = "x86_64")]
+static COMPRESS_DOWN: [[u32; WIDTH]; 1 << WIDTH] = {
+    let mut t = [[0u32; WIDTH]; 1 << WIDTH];
+    let mut m = 0;
+    while m < 1 << WIDTH {
+        let (mut k, mut i) = (0, WIDTH);
+        while i > 0 {
+            i -= 1;
+            if m & (1 << i) != 0 {
+                t[m][k] = i as u32;
+                k += 1;
+            }
+        }
+        m += 1;
+    }
+    t
+};
+
+/// Writes an entry for every child of `node` that some ray entered
+/// (`child[i] != 0`), highest slot first as the scalar loop does, with two
+/// permutes, two unpacks and two stores and no branch (which children the
+/// group enters is unpredictable); returns their number. All `WIDTH`
+/// entries of `out` are written; those past the number are garbage.
+///
+/// # Safety
+/// The CPU must have AVX2, and `out` must be valid for `WIDTH` writes.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn push_entered(out: *mut Entry, node: &Node, child: &[u32; WIDTH]) -> usize {
+    use core::arch::x86_64::{
+        __m256i, _mm256_castsi256_ps, _mm256_cmpeq_epi32, _mm256_loadu_si256, _mm256_movemask_ps,
+        _mm256_permute2x128_si256, _mm256_permutevar8x32_epi32, _mm256_setzero_si256,
+        _mm256_storeu_si256, _mm256_unpackhi_epi32, _mm256_unpacklo_epi32,
+    };
+    // SAFETY: the caller guarantees AVX2 and `out`; `child` and
+    // `node.children` are `WIDTH` u32s (32 bytes, read unaligned); the
+    // mask has 8 bits, so it indexes the table.
+    unsafe {
+        let rays = _mm256_loadu_si256(child.as_ptr().cast::<__m256i>());
+        let none = _mm256_cmpeq_epi32(rays, _mm256_setzero_si256());
+        let mask = !(_mm256_movemask_ps(_mm256_castsi256_ps(none)) as u32) & 0xff;
+        let perm = COMPRESS_DOWN.get_unchecked(mask as usize);
+        let perm = _mm256_loadu_si256(perm.as_ptr().cast::<__m256i>());
+        let kids = _mm256_loadu_si256(node.children.as_ptr().cast::<__m256i>());
+        let (kids, rays) =
+            (_mm256_permutevar8x32_epi32(kids, perm), _mm256_permutevar8x32_epi32(rays, perm));
+        // Pairs 0, 1 | 4, 5 and 2, 3 | 6, 7, then in order.
+        let (lo, hi) = (_mm256_unpacklo_epi32(kids, rays), _mm256_unpackhi_epi32(kids, rays));
+        _mm256_storeu_si256(out.cast::<__m256i>(), _mm256_permute2x128_si256::<0x20>(lo, hi));
+        _mm256_storeu_si256(
+            out.add(4).cast::<__m256i>(),
+            _mm256_permute2x128_si256::<0x31>(lo, hi),
+        );
+        mask.count_ones() as usize
     }
 }
