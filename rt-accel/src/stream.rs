@@ -374,22 +374,7 @@ fn push_group<const AVX: bool>(
 /// For each 8-bit child mask, the slots of its set bits from the highest
 /// down, padded with slot 0.
 #[cfg(target_arch = "x86_64")]
-static COMPRESS_DOWN: [[u32; WIDTH]; 1 << WIDTH] = {
-    let mut t = [[0u32; WIDTH]; 1 << WIDTH];
-    let mut m = 0;
-    while m < 1 << WIDTH {
-        let (mut k, mut i) = (0, WIDTH);
-        while i > 0 {
-            i -= 1;
-            if m & (1 << i) != 0 {
-                t[m][k] = i as u32;
-                k += 1;
-            }
-        }
-        m += 1;
-    }
-    t
-};
+static COMPRESS_DOWN: [[u32; WIDTH]; 1 << WIDTH] = crate::traverse::compress_table(true);
 
 /// Writes an entry for every child of `node` that some ray entered
 /// (`child[i] != 0`), highest slot first as the scalar loop does, with two

@@ -529,22 +529,29 @@ fn push_children<const AVX: bool>(
 /// For each 8-bit child mask, the slots of its set bits in order, padded
 /// with slot 0: the permutation that packs a node's hit children together.
 #[cfg(target_arch = "x86_64")]
-static COMPRESS: [[u32; WIDTH]; 1 << WIDTH] = {
+static COMPRESS: [[u32; WIDTH]; 1 << WIDTH] = compress_table(false);
+
+/// The packing permutations for every 8-bit mask: the slots of its set
+/// bits in ascending order (`descending`: from the highest down), padded
+/// with slot 0.
+#[cfg(target_arch = "x86_64")]
+pub(crate) const fn compress_table(descending: bool) -> [[u32; WIDTH]; 1 << WIDTH] {
     let mut t = [[0u32; WIDTH]; 1 << WIDTH];
     let mut m = 0;
     while m < 1 << WIDTH {
-        let (mut k, mut i) = (0, 0);
-        while i < WIDTH {
+        let (mut k, mut j) = (0, 0);
+        while j < WIDTH {
+            let i = if descending { WIDTH - 1 - j } else { j };
             if m & (1 << i) != 0 {
                 t[m][k] = i as u32;
                 k += 1;
             }
-            i += 1;
+            j += 1;
         }
         m += 1;
     }
     t
-};
+}
 
 /// Writes the children of `node` named by `mask` to `out[0..popcount]`
 /// in slot order, with one 8-lane permute and store and no branch (the

@@ -37,7 +37,7 @@ mod tinybvh;
 mod traversal;
 mod unstructured;
 
-use std::{path::PathBuf, process::ExitCode};
+use std::{io::Write as _, path::PathBuf, process::ExitCode};
 
 /// Where reports go: `$CARGO_TARGET_DIR/rt-report` or `target/rt-report` at
 /// the workspace root.
@@ -137,7 +137,9 @@ fn main() -> ExitCode {
     let t0 = std::time::Instant::now();
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.iter().any(|a| a == "--help" || a == "-h") {
-        println!("{USAGE}");
+        // Not `println!`, which panics when the reader has gone
+        // (`rt-report --help | head`).
+        let _ = writeln!(std::io::stdout(), "{USAGE}");
         return ExitCode::SUCCESS;
     }
     if let Some(bad) = args.iter().find(|a| a.starts_with('-') && *a != "--quick") {
