@@ -26,7 +26,7 @@ use rt_core::{Ray, internal::widen_far};
 use crate::{
     Isa, RayCtx,
     node::{ChildRef, GROUPS, Node, WIDTH},
-    prim::{BestHit, Primitive},
+    prim::{BestHit, Primitive, any_leaf, closest_leaf},
     traverse::{BvhRef, STACK_SIZE, TraversalStack, TraversalStats},
 };
 use rt_core::internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG};
@@ -385,9 +385,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                     let r = bits.trailing_zeros() as usize;
                     bits &= bits - 1;
                     if let Some(ctx) = &l.ctx[r] {
-                        for (k, item) in self.leaf(first, count).iter().enumerate() {
-                            item.closest((first + k) as u32, ctx, &mut best[r]);
-                        }
+                        closest_leaf(self.leaf(first, count), first, ctx, &mut best[r]);
                     }
                 }
             } else {
@@ -464,7 +462,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                     bits &= bits - 1;
                     if let Some(ctx) = &l.ctx[r] {
                         let t_max = ctx.ray.t_max;
-                        if crate::stream::any_hit(self.leaf(first, count), ctx, t_max) {
+                        if any_leaf::<P, AVX>(self.leaf(first, count), ctx, t_max) {
                             done |= 1 << r;
                         }
                     }

@@ -188,9 +188,22 @@ mod avx {
         pub(crate) unsafe fn blend(self, b: Self, mask: Self) -> Self {
             Self(unsafe { _mm256_blendv_ps(self.0, b.0, mask.0) })
         }
+        /// `lo` in lanes 0–3, `hi` in lanes 4–7.
+        #[inline(always)]
+        pub(crate) fn from_halves(lo: [f32; 4], hi: [f32; 4]) -> Self {
+            Self(bytemuck::cast([lo, hi]))
+        }
+        #[inline(always)]
+        pub(crate) unsafe fn add(self, o: Self) -> Self {
+            Self(unsafe { _mm256_add_ps(self.0, o.0) })
+        }
         #[inline(always)]
         pub(crate) unsafe fn sub(self, o: Self) -> Self {
             Self(unsafe { _mm256_sub_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        pub(crate) unsafe fn div(self, o: Self) -> Self {
+            Self(unsafe { _mm256_div_ps(self.0, o.0) })
         }
         #[inline(always)]
         pub(crate) unsafe fn mul(self, o: Self) -> Self {
@@ -210,6 +223,16 @@ mod avx {
         #[inline(always)]
         pub(crate) unsafe fn le_mask(self, o: Self) -> u32 {
             (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) }) as u32
+        }
+        /// Bit `i` set where lane `i` has `self < o` (false for NaN).
+        #[inline(always)]
+        pub(crate) unsafe fn lt_mask(self, o: Self) -> u32 {
+            (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0)) }) as u32
+        }
+        /// Bit `i` set where lane `i` has `self == o` (false for NaN).
+        #[inline(always)]
+        pub(crate) unsafe fn eq_mask(self, o: Self) -> u32 {
+            (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0)) }) as u32
         }
         /// All ones in the lanes where `self <= o` (none for NaN), else 0.
         #[inline(always)]
@@ -247,6 +270,86 @@ mod avx {
 
 #[cfg(target_arch = "x86_64")]
 pub(crate) use avx::F32x8;
+
+/// The lane arithmetic the triangle test is written in, four lanes
+/// ([`F32x4`]) or eight ([`F32x8`]): one generic test, the same IEEE
+/// operations per lane at either width.
+///
+/// The methods are `unsafe` because [`F32x8`]'s need AVX: call them only
+/// where the lane type's own methods may run (for [`F32x4`], anywhere).
+pub(crate) trait Lanes: Copy {
+    /// The lanes as an array.
+    type Array: core::ops::Index<usize, Output = f32>;
+    /// The mask with a bit for every lane.
+    const ALL: u32;
+    unsafe fn splat(x: f32) -> Self;
+    unsafe fn add(self, o: Self) -> Self;
+    unsafe fn sub(self, o: Self) -> Self;
+    unsafe fn mul(self, o: Self) -> Self;
+    unsafe fn div(self, o: Self) -> Self;
+    unsafe fn le_mask(self, o: Self) -> u32;
+    unsafe fn lt_mask(self, o: Self) -> u32;
+    unsafe fn eq_mask(self, o: Self) -> u32;
+    fn to_lanes(self) -> Self::Array;
+}
+
+/// Implements [`Lanes`] by the type's own methods (inherent methods win
+/// over the trait's in the paths below).
+macro_rules! lanes_by_inherent {
+    ($t:ty, $n:literal $(, $unsafe:tt)?) => {
+        impl Lanes for $t {
+            type Array = [f32; $n];
+            const ALL: u32 = (1 << $n) - 1;
+            #[inline(always)]
+            unsafe fn splat(x: f32) -> Self {
+                // SAFETY: the trait's contract is the type's.
+                $($unsafe)? { <$t>::splat(x) }
+            }
+            #[inline(always)]
+            unsafe fn add(self, o: Self) -> Self {
+                // SAFETY: as above.
+                $($unsafe)? { <$t>::add(self, o) }
+            }
+            #[inline(always)]
+            unsafe fn sub(self, o: Self) -> Self {
+                // SAFETY: as above.
+                $($unsafe)? { <$t>::sub(self, o) }
+            }
+            #[inline(always)]
+            unsafe fn mul(self, o: Self) -> Self {
+                // SAFETY: as above.
+                $($unsafe)? { <$t>::mul(self, o) }
+            }
+            #[inline(always)]
+            unsafe fn div(self, o: Self) -> Self {
+                // SAFETY: as above.
+                $($unsafe)? { <$t>::div(self, o) }
+            }
+            #[inline(always)]
+            unsafe fn le_mask(self, o: Self) -> u32 {
+                // SAFETY: as above.
+                $($unsafe)? { <$t>::le_mask(self, o) }
+            }
+            #[inline(always)]
+            unsafe fn lt_mask(self, o: Self) -> u32 {
+                // SAFETY: as above.
+                $($unsafe)? { <$t>::lt_mask(self, o) }
+            }
+            #[inline(always)]
+            unsafe fn eq_mask(self, o: Self) -> u32 {
+                // SAFETY: as above.
+                $($unsafe)? { <$t>::eq_mask(self, o) }
+            }
+            #[inline(always)]
+            fn to_lanes(self) -> [f32; $n] {
+                self.to_array()
+            }
+        }
+    };
+}
+lanes_by_inherent!(F32x4, 4);
+#[cfg(target_arch = "x86_64")]
+lanes_by_inherent!(F32x8, 8, unsafe);
 
 /// Hints the CPU to start loading the cache lines of `bytes` bytes from
 /// `r` on (every line they touch, whatever `r`'s alignment).

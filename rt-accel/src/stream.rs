@@ -21,7 +21,7 @@ use rt_core::{Ray, internal::widen_far};
 use crate::{
     Isa, RayCtx,
     node::{ChildRef, Node, WIDTH},
-    prim::{BestHit, Primitive},
+    prim::{BestHit, Primitive, any_leaf},
     traverse::{BvhRef, STACK_SIZE, TraversalStack, TraversalStats, Walk, box_test},
 };
 
@@ -234,7 +234,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                         let r = m.trailing_zeros() as usize;
                         m &= m - 1;
                         let ctx = &ctxs[r];
-                        if any_hit(items, ctx, ctx.ray.t_max) {
+                        if any_leaf::<P, AVX>(items, ctx, ctx.ray.t_max) {
                             occluded |= 1 << r;
                         }
                     }
@@ -255,21 +255,6 @@ impl<P: Primitive> BvhRef<'_, P> {
             Entry { node: cur, rays } = stack.0[sp];
         }
     }
-}
-
-/// Whether `ctx`'s ray hits any of `items` before `t_max`. A plain loop,
-/// always inlined, so the leaf tests compile with the calling kernel's
-/// instruction set: `items.iter().any(…)` was left out of line, a generic
-/// function built for the baseline target (a fifth of an AO stream's
-/// time, on SSE2 code).
-#[inline(always)]
-pub(crate) fn any_hit<P: Primitive>(items: &[P], ctx: &RayCtx, t_max: f32) -> bool {
-    for item in items {
-        if item.any(ctx, t_max) {
-            return true;
-        }
-    }
-    false
 }
 
 /// Which of the rays in `active` (bits of `ctxs`) enter each child of

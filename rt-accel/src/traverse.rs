@@ -8,7 +8,7 @@ use rt_core::{Aabb, Hit, Ray, SceneQuery, internal::widen_far};
 use crate::{
     Isa, RayCtx, UnsupportedIsa,
     node::{ChildRef, GROUPS, Node, WIDTH},
-    prim::{BestHit, Primitive},
+    prim::{BestHit, Primitive, any_leaf, closest_leaf},
     simd::prefetch_bytes,
 };
 
@@ -230,10 +230,8 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         loop {
             if cur.is_leaf() {
                 let (first, count) = cur.leaf_range();
-                for item in self.leaf(first, count) {
-                    if item.any(ctx, t_max) {
-                        return true;
-                    }
+                if any_leaf::<P, AVX>(self.leaf(first, count), ctx, t_max) {
+                    return true;
                 }
             } else {
                 let node = self.node(cur);
@@ -397,9 +395,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         if cur.is_leaf() {
             let (first, count) = cur.leaf_range();
             stats.items += count as u32;
-            for (k, item) in self.leaf(first, count).iter().enumerate() {
-                item.closest((first + k) as u32, ctx, best);
-            }
+            closest_leaf(self.leaf(first, count), first, ctx, best);
         } else {
             stats.nodes += 1;
             let node = self.node(*cur);

@@ -15,10 +15,12 @@ use rt_core::{
     intersect::{TriangleHit, intersect_triangle_t, triangle_hit},
 };
 
+#[cfg(target_arch = "x86_64")]
+use crate::simd::F32x8;
 use crate::{
     RayCtx,
     prim::{BestHit, Primitive, Sealed},
-    simd::F32x4,
+    simd::{F32x4, Lanes},
 };
 
 /// Up to four triangles in structure-of-arrays form: `v[k][axis][lane]` is
@@ -80,46 +82,148 @@ impl TriPacket {
         let (a, b, c) = (self.vertex(lane, 0), self.vertex(lane, 1), self.vertex(lane, 2));
         intersect_triangle_t(ray, &pre.wt, a, b, c)
     }
+}
 
-    /// Lane masks: `(candidates, zero_lanes)` and the lanes' `t`. A candidate
-    /// passed the sign test, has `det ≠ 0` and `t ∈ [t_min, t_max]`; zero
-    /// lanes must be redone by the scalar test.
+/// Where the triangle test's lanes come from: one packet (four lanes) or
+/// two side by side (eight, for the AVX kernels).
+trait Verts {
+    type L: Lanes;
+    /// Coordinate `axis` of vertex `k`, per lane.
+    ///
+    /// # Safety
+    /// As [`Lanes`]: the lane type's methods may run here.
+    unsafe fn coord(&self, k: usize, axis: usize) -> Self::L;
+}
+
+impl Verts for TriPacket {
+    type L = F32x4;
     #[inline(always)]
-    fn lanes(&self, ctx: &RayCtx, t_max: F32x4) -> (u32, u32, [f32; 4]) {
+    unsafe fn coord(&self, k: usize, axis: usize) -> F32x4 {
+        F32x4::from_array(self.v[k][axis])
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Verts for [TriPacket; 2] {
+    type L = F32x8;
+    #[inline(always)]
+    unsafe fn coord(&self, k: usize, axis: usize) -> F32x8 {
+        F32x8::from_halves(self[0].v[k][axis], self[1].v[k][axis])
+    }
+}
+
+/// Lane masks: `(candidates, zero_lanes)` and the lanes' `t`. A candidate
+/// passed the sign test, has `det ≠ 0` and `t ∈ [t_min, t_max]`; zero
+/// lanes must be redone by the scalar test. Lane `l` of two packets is
+/// lane `l % 4` of packet `l / 4`, computed with the same operations.
+///
+/// # Safety
+/// As [`Lanes`]: `V::L`'s methods may run here.
+#[inline(always)]
+unsafe fn lanes<V: Verts>(
+    tris: &V,
+    ctx: &RayCtx,
+    t_max: f32,
+) -> (u32, u32, <V::L as Lanes>::Array) {
+    // Vertex `k` relative to the origin, sheared (a function, not a
+    // closure: closures are not always inlined, and one left out of line
+    // is compiled without the kernel's instruction set).
+    #[inline(always)]
+    unsafe fn vert<V: Verts>(tris: &V, ctx: &RayCtx, k: usize) -> (V::L, V::L, V::L) {
         let [kx, ky, kz] = ctx.wt.axes;
-        let [ox, oy, oz] = ctx.wt_org.to_array().map(F32x4::splat);
-        let [sx, sy, sz] = ctx.wt.shear.to_array().map(F32x4::splat);
-        let vert = |k: usize| {
-            let p = &self.v[k];
-            let x = F32x4::from_array(p[kx]).sub(ox);
-            let y = F32x4::from_array(p[ky]).sub(oy);
-            let z = F32x4::from_array(p[kz]).sub(oz);
-            (x.sub(sx.mul(z)), y.sub(sy.mul(z)), z)
-        };
-        let (ax, ay, az) = vert(0);
-        let (bx, by, bz) = vert(1);
-        let (cx, cy, cz) = vert(2);
+        let [ox, oy, oz] = ctx.wt_org.to_array();
+        let [sx, sy, _] = ctx.wt.shear.to_array();
+        // SAFETY: the caller's guarantee.
+        unsafe {
+            let splat = <V::L as Lanes>::splat;
+            let x = tris.coord(k, kx).sub(splat(ox));
+            let y = tris.coord(k, ky).sub(splat(oy));
+            let z = tris.coord(k, kz).sub(splat(oz));
+            (x.sub(splat(sx).mul(z)), y.sub(splat(sy).mul(z)), z)
+        }
+    }
+    // SAFETY: the caller's guarantee.
+    unsafe {
+        let splat = <V::L as Lanes>::splat;
+        let sz = splat(ctx.wt.shear.z);
+        let (ax, ay, az) = vert(tris, ctx, 0);
+        let (bx, by, bz) = vert(tris, ctx, 1);
+        let (cx, cy, cz) = vert(tris, ctx, 2);
         let u = cx.mul(by).sub(cy.mul(bx));
         let v = ax.mul(cy).sub(ay.mul(cx));
         let w = bx.mul(ay).sub(by.mul(ax));
-        let zero = F32x4::splat(0.0);
+        let zero = splat(0.0);
         let on_edge = u.eq_mask(zero) | v.eq_mask(zero) | w.eq_mask(zero);
         let neg = u.lt_mask(zero) | v.lt_mask(zero) | w.lt_mask(zero);
         let pos = zero.lt_mask(u) | zero.lt_mask(v) | zero.lt_mask(w);
         let det = u.add(v).add(w);
         let tt = u.mul(sz.mul(az)).add(v.mul(sz.mul(bz))).add(w.mul(sz.mul(cz)));
-        let t = tt.mul(F32x4::splat(1.0).div(det));
-        let inf = F32x4::splat(f32::INFINITY);
+        let t = tt.mul(splat(1.0).div(det));
+        let inf = splat(f32::INFINITY);
         // `t < ∞` as the scalar test: an overflowed `t` is no hit.
-        let in_range = F32x4::splat(ctx.ray.t_min).le_mask(t) & t.le_mask(t_max) & t.lt_mask(inf);
+        let in_range = splat(ctx.ray.t_min).le_mask(t) & t.le_mask(splat(t_max)) & t.lt_mask(inf);
         // As the scalar test: an overflowed `det` is no hit.
-        let finite = det.lt_mask(inf) & F32x4::splat(f32::NEG_INFINITY).lt_mask(det);
-        let ok = !(neg & pos) & !det.eq_mask(zero) & finite & in_range & !on_edge & 0xf;
-        (ok, on_edge & 0xf, t.to_array())
+        let finite = det.lt_mask(inf) & splat(f32::NEG_INFINITY).lt_mask(det);
+        let all = <V::L as Lanes>::ALL;
+        let ok = !(neg & pos) & !det.eq_mask(zero) & finite & in_range & !on_edge & all;
+        (ok, on_edge & all, t.to_lanes())
     }
 }
 
-impl Sealed for TriPacket {}
+/// Whether any lane [`lanes`] found for `packets` is a hit before `t_max`
+/// (candidates that fail the scalar test's final box check, and the
+/// zero lanes, are settled by the scalar test).
+#[inline(always)]
+fn any_lane(
+    packets: &[TriPacket],
+    (mut ok, mut edge, t): (u32, u32, impl core::ops::Index<usize, Output = f32>),
+    ctx: &RayCtx,
+    t_max: f32,
+) -> bool {
+    while ok != 0 {
+        let l = ok.trailing_zeros() as usize;
+        ok &= ok - 1;
+        if packets[l / 4].admits(l % 4, ctx, t[l]) {
+            return true;
+        }
+        edge |= 1 << l;
+    }
+    let r = Ray { t_max, ..ctx.ray };
+    while edge != 0 {
+        let l = edge.trailing_zeros() as usize;
+        edge &= edge - 1;
+        if packets[l / 4].scalar(l % 4, &r, ctx).is_some() {
+            return true;
+        }
+    }
+    false
+}
+
+/// [`Primitive::any`] over a leaf's packets, two at a time in eight
+/// lanes: the same answer as one packet after the other.
+///
+/// # Safety
+/// The CPU must have AVX. Always inlined, into the kernels compiled with it.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) unsafe fn any_x8(packets: &[TriPacket], ctx: &RayCtx, t_max: f32) -> bool {
+    let (pairs, rest) = packets.as_chunks::<2>();
+    for pair in pairs {
+        // SAFETY: the caller guarantees AVX.
+        if any_lane(pair, unsafe { lanes(pair, ctx, t_max) }, ctx, t_max) {
+            return true;
+        }
+    }
+    // A plain `if let`: a closure (`is_some_and`) may be left out of line.
+    if let [last] = rest { last.any(ctx, t_max) } else { false }
+}
+
+impl Sealed for TriPacket {
+    #[inline(always)]
+    fn as_tri_packets(items: &[Self]) -> Option<&[TriPacket]> {
+        Some(items)
+    }
+}
 
 impl Primitive for TriPacket {
     const KIND: PrimKind = PrimKind::Triangle;
@@ -129,7 +233,8 @@ impl Primitive for TriPacket {
     // instruction set (measured: +4–8 % on primary rays with AVX2).
     #[inline(always)]
     fn closest(&self, item: u32, ctx: &RayCtx, best: &mut BestHit) {
-        let (mut ok, mut edge, t) = self.lanes(ctx, F32x4::splat(best.t));
+        // SAFETY: four lanes run anywhere.
+        let (mut ok, mut edge, t) = unsafe { lanes(self, ctx, best.t) };
         while ok != 0 {
             let lane = ok.trailing_zeros();
             ok &= ok - 1;
@@ -154,24 +259,9 @@ impl Primitive for TriPacket {
 
     #[inline(always)]
     fn any(&self, ctx: &RayCtx, t_max: f32) -> bool {
-        let (mut ok, mut edge, t) = self.lanes(ctx, F32x4::splat(t_max));
-        while ok != 0 {
-            let lane = ok.trailing_zeros() as usize;
-            ok &= ok - 1;
-            if self.admits(lane, ctx, t[lane]) {
-                return true;
-            }
-            edge |= 1 << lane;
-        }
-        let r = Ray { t_max, ..ctx.ray };
-        while edge != 0 {
-            let lane = edge.trailing_zeros() as usize;
-            edge &= edge - 1;
-            if self.scalar(lane, &r, ctx).is_some() {
-                return true;
-            }
-        }
-        false
+        // SAFETY: four lanes run anywhere.
+        let found = unsafe { lanes(self, ctx, t_max) };
+        any_lane(core::slice::from_ref(self), found, ctx, t_max)
     }
 
     fn hit(&self, lane: u32, ray: &Ray, t: f32) -> Option<Hit> {
