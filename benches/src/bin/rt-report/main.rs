@@ -193,14 +193,17 @@ fn main() -> ExitCode {
         };
         match result {
             Ok(s) => {
-                println!("## {}\n\n{}", s.title, s.body);
+                let mut text = format!("## {}\n\n{}\n", s.title, s.body);
                 for v in &s.verdicts {
-                    println!("- {v}");
+                    text += &format!("- {v}\n");
                 }
                 for (file, caption) in &s.plots {
-                    println!("- plot {}: {caption}", dir.join(file).display());
+                    text += &format!("- plot {}: {caption}\n", dir.join(file).display());
                 }
-                println!();
+                // Written, not `println!`ed: a reader that has gone
+                // (`rt-report traversal | head`) must not panic the
+                // report, which still writes its files.
+                let _ = writeln!(std::io::stdout(), "{text}");
                 sections.push((area, s));
             }
             Err(e) => {
@@ -215,7 +218,7 @@ fn main() -> ExitCode {
             eprintln!("cannot write {}: {e}", path.display());
             return ExitCode::FAILURE;
         }
-        println!("wrote {}", path.display());
+        let _ = writeln!(std::io::stdout(), "wrote {}", path.display());
     }
     ExitCode::SUCCESS
 }
