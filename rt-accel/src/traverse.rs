@@ -132,8 +132,11 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     }
 
     /// Like [`BvhRef::closest_hit`], counting the work done into `stats`.
+    /// Runs the portable kernel, which visits the same nodes and items as
+    /// every other (their box masks and orders are identical), so the
+    /// fast kernels need not count.
     pub fn closest_hit_stats(&self, ray: &Ray, stats: &mut TraversalStats) -> Option<Hit> {
-        let best = self.closest_best(ray, stats, &mut TraversalStack::new())?;
+        let best = self.closest_kernel::<false>(ray, stats, &mut TraversalStack::new())?;
         best.is_hit().then(|| self.record(best, ray))?
     }
 
@@ -150,7 +153,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         if self.nodes.is_empty() {
             return None;
         }
-        let best = self.closest_best(ray, &mut TraversalStats::default(), stack)?;
+        let best = self.closest_best(ray, stack)?;
         best.is_hit().then_some(best)
     }
 
@@ -294,46 +297,32 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     }
 
     /// The closest-hit traversal on this BVH's kernel; `None` for an
-    /// invalid ray.
+    /// invalid ray. Its statistics are a local nobody reads, so they
+    /// compile away: counted through a pointer, they cost a store per node.
     #[inline]
-    fn closest_best(
-        &self,
-        ray: &Ray,
-        stats: &mut TraversalStats,
-        stack: &mut TraversalStack,
-    ) -> Option<BestHit> {
+    fn closest_best(&self, ray: &Ray, stack: &mut TraversalStack) -> Option<BestHit> {
         match self.isa {
             // SAFETY: `self.isa` passed `Isa::is_available` (the field's
             // invariant): the CPU has the features these kernels enable.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => unsafe { self.closest_avx512(ray, stats, stack) },
+            Isa::Avx512 => unsafe { self.closest_avx512(ray, stack) },
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
-            Isa::Avx2 => unsafe { self.closest_avx2(ray, stats, stack) },
-            _ => self.closest_kernel::<false>(ray, stats, stack),
+            Isa::Avx2 => unsafe { self.closest_avx2(ray, stack) },
+            _ => self.closest_kernel::<false>(ray, &mut TraversalStats::default(), stack),
         }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
-    fn closest_avx2(
-        &self,
-        ray: &Ray,
-        stats: &mut TraversalStats,
-        stack: &mut TraversalStack,
-    ) -> Option<BestHit> {
-        self.closest_kernel::<true>(ray, stats, stack)
+    fn closest_avx2(&self, ray: &Ray, stack: &mut TraversalStack) -> Option<BestHit> {
+        self.closest_kernel::<true>(ray, &mut TraversalStats::default(), stack)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
-    fn closest_avx512(
-        &self,
-        ray: &Ray,
-        stats: &mut TraversalStats,
-        stack: &mut TraversalStack,
-    ) -> Option<BestHit> {
-        self.closest_kernel::<true>(ray, stats, stack)
+    fn closest_avx512(&self, ray: &Ray, stack: &mut TraversalStack) -> Option<BestHit> {
+        self.closest_kernel::<true>(ray, &mut TraversalStats::default(), stack)
     }
 
     /// The traversal kernel: front-to-back by entry distance, culling
