@@ -1,6 +1,7 @@
 //! Embree 3 (feature `embree3`) as one more implementation in the
 //! traversal table: its own BVH (default build quality) and single-ray
-//! `rtcIntersect1` / `rtcOccluded1`, same triangles, same rays.
+//! `rtcIntersect1` / `rtcOccluded1`, same triangles, same rays, in its
+//! default mode and in its robust one.
 
 use cgmath::{Vector3, Vector4};
 use embree::{
@@ -16,7 +17,10 @@ pub(crate) struct EmbreeScene {
 }
 
 impl EmbreeScene {
-    pub(crate) fn new(positions: &[Vec3], indices: &[[u32; 3]]) -> Self {
+    /// `robust`: with `RTC_SCENE_FLAG_ROBUST`, Embree's mode that avoids
+    /// the optimizations that cost accuracy (its robust box test and a
+    /// watertight triangle test, as rt always does).
+    pub(crate) fn new(positions: &[Vec3], indices: &[[u32; 3]], robust: bool) -> Self {
         let device: &'static Device = Box::leak(Box::new(Device::new()));
         let mut mesh = TriangleMesh::unanimated(device, indices.len(), positions.len());
         {
@@ -33,6 +37,12 @@ impl EmbreeScene {
         geom.commit();
         let scene: &'static mut Scene<'static> = Box::leak(Box::new(Scene::new(device)));
         scene.attach_geometry(geom);
+        if robust {
+            // SAFETY: the handle is the live scene's, not yet committed.
+            unsafe {
+                embree::sys::rtcSetSceneFlags(scene.handle(), embree::SceneFlags::ROBUST);
+            }
+        }
         Self { scene: scene.commit() }
     }
 

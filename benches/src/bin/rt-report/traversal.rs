@@ -30,7 +30,7 @@ use crate::{
 const REPS: usize = 5;
 
 /// The anchors rt's single-ray queries (row `rt`) are held against.
-const SINGLE_ANCHORS: [&str; 3] = ["embree3", "tinybvh", "tinybvh-bvh8cpu"];
+const SINGLE_ANCHORS: [&str; 4] = ["embree3", "embree3-robust", "tinybvh", "tinybvh-bvh8cpu"];
 
 struct Scene {
     name: &'static str,
@@ -148,7 +148,10 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
 
         let to_o = |r: &Ray| ORay::new(r.origin.into(), r.direction.into(), r.t_min, r.t_max);
         #[cfg(feature = "embree3")]
-        let embree = crate::embree3::EmbreeScene::new(&s.mesh.positions, &s.mesh.indices);
+        let embree = crate::embree3::EmbreeScene::new(&s.mesh.positions, &s.mesh.indices, false);
+        #[cfg(feature = "embree3")]
+        let embree_robust =
+            crate::embree3::EmbreeScene::new(&s.mesh.positions, &s.mesh.indices, true);
         #[cfg(feature = "tinybvh")]
         let tiny = crate::tinybvh::TinyScene::new(&s.mesh.positions, &s.mesh.indices)?;
         // rt: the kernel it picks at run time, then each kernel forced.
@@ -237,19 +240,23 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
                 })
             }),
         ));
+        // Embree single rays, in its default mode and its robust one (the
+        // like-for-like anchor: rt's tests are always the robust kind).
         #[cfg(feature = "embree3")]
-        tracers.push((
-            "embree3".into(),
-            Box::new(|rays: &[Ray], q: Query| {
-                let mut ctx = crate::embree3::context();
-                match q {
-                    Query::Closest => count(rays, |r| embree.closest(&mut ctx, r)),
-                    Query::Occluded => {
-                        count(rays, |r| embree.occluded(&mut ctx, r).then_some((0.0, 0)))
+        for (name, scene) in [("embree3", &embree), ("embree3-robust", &embree_robust)] {
+            tracers.push((
+                name.into(),
+                Box::new(move |rays: &[Ray], q: Query| {
+                    let mut ctx = crate::embree3::context();
+                    match q {
+                        Query::Closest => count(rays, |r| scene.closest(&mut ctx, r)),
+                        Query::Occluded => {
+                            count(rays, |r| scene.occluded(&mut ctx, r).then_some((0.0, 0)))
+                        }
                     }
-                }
-            }),
-        ));
+                }),
+            ));
+        }
         // Embree's stream API, told the rays are coherent (its packet
         // traversal) and incoherent (ray by ray).
         #[cfg(feature = "embree3")]
@@ -415,8 +422,9 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         // for the same triangles.
         #[cfg(feature = "embree3")]
         {
-            let (secs, _) =
-                time(|| crate::embree3::EmbreeScene::new(&s.mesh.positions, &s.mesh.indices));
+            let (secs, _) = time(|| {
+                crate::embree3::EmbreeScene::new(&s.mesh.positions, &s.mesh.indices, false)
+            });
             writeln!(build_csv, "{},{ntri},embree3-default,{secs:.4},", s.name).unwrap();
         }
     }
