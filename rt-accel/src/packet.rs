@@ -142,7 +142,7 @@ unsafe fn child_test_avx(
     l: &Lanes,
     t_max: &[f32; PACKET],
 ) -> (u32, [f32; PACKET]) {
-    use crate::simd::F32x8;
+    use crate::simd::{F32x8, Lanes as _};
     let (g, k) = (c / 4, c % 4);
     let b = &node.bounds;
     #[inline(always)]

@@ -168,10 +168,6 @@ mod avx {
     // SAFETY (every method): the caller guarantees the CPU has AVX.
     impl F32x8 {
         #[inline(always)]
-        pub(crate) unsafe fn splat(x: f32) -> Self {
-            Self(unsafe { _mm256_set1_ps(x) })
-        }
-        #[inline(always)]
         pub(crate) fn from_groups(g: [[f32; 4]; 2]) -> Self {
             Self(bytemuck::cast(g))
         }
@@ -193,22 +189,6 @@ mod avx {
         pub(crate) fn from_halves(lo: [f32; 4], hi: [f32; 4]) -> Self {
             Self(bytemuck::cast([lo, hi]))
         }
-        #[inline(always)]
-        pub(crate) unsafe fn add(self, o: Self) -> Self {
-            Self(unsafe { _mm256_add_ps(self.0, o.0) })
-        }
-        #[inline(always)]
-        pub(crate) unsafe fn sub(self, o: Self) -> Self {
-            Self(unsafe { _mm256_sub_ps(self.0, o.0) })
-        }
-        #[inline(always)]
-        pub(crate) unsafe fn div(self, o: Self) -> Self {
-            Self(unsafe { _mm256_div_ps(self.0, o.0) })
-        }
-        #[inline(always)]
-        pub(crate) unsafe fn mul(self, o: Self) -> Self {
-            Self(unsafe { _mm256_mul_ps(self.0, o.0) })
-        }
         /// `self` if `self > o`, else `o` (NaN in either gives `o`).
         #[inline(always)]
         pub(crate) unsafe fn max(self, o: Self) -> Self {
@@ -218,21 +198,6 @@ mod avx {
         #[inline(always)]
         pub(crate) unsafe fn min(self, o: Self) -> Self {
             Self(unsafe { _mm256_min_ps(self.0, o.0) })
-        }
-        /// Bit `i` set where lane `i` has `self <= o` (false for NaN).
-        #[inline(always)]
-        pub(crate) unsafe fn le_mask(self, o: Self) -> u32 {
-            (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) }) as u32
-        }
-        /// Bit `i` set where lane `i` has `self < o` (false for NaN).
-        #[inline(always)]
-        pub(crate) unsafe fn lt_mask(self, o: Self) -> u32 {
-            (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0)) }) as u32
-        }
-        /// Bit `i` set where lane `i` has `self == o` (false for NaN).
-        #[inline(always)]
-        pub(crate) unsafe fn eq_mask(self, o: Self) -> u32 {
-            (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0)) }) as u32
         }
         /// All ones in the lanes where `self <= o` (none for NaN), else 0.
         #[inline(always)]
@@ -266,6 +231,48 @@ mod avx {
             (unsafe { _mm256_movemask_ps(self.0) }) as u32
         }
     }
+
+    // The arithmetic shared with `F32x4` (SAFETY, every method: as above).
+    impl super::Lanes for F32x8 {
+        type Array = [f32; 8];
+        const ALL: u32 = 0xff;
+        #[inline(always)]
+        unsafe fn splat(x: f32) -> Self {
+            Self(unsafe { _mm256_set1_ps(x) })
+        }
+        #[inline(always)]
+        unsafe fn add(self, o: Self) -> Self {
+            Self(unsafe { _mm256_add_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        unsafe fn sub(self, o: Self) -> Self {
+            Self(unsafe { _mm256_sub_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        unsafe fn mul(self, o: Self) -> Self {
+            Self(unsafe { _mm256_mul_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        unsafe fn div(self, o: Self) -> Self {
+            Self(unsafe { _mm256_div_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        unsafe fn le_mask(self, o: Self) -> u32 {
+            (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) }) as u32
+        }
+        #[inline(always)]
+        unsafe fn lt_mask(self, o: Self) -> u32 {
+            (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0)) }) as u32
+        }
+        #[inline(always)]
+        unsafe fn eq_mask(self, o: Self) -> u32 {
+            (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0)) }) as u32
+        }
+        #[inline(always)]
+        fn to_lanes(self) -> [f32; 8] {
+            self.to_array()
+        }
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -293,63 +300,47 @@ pub(crate) trait Lanes: Copy {
     fn to_lanes(self) -> Self::Array;
 }
 
-/// Implements [`Lanes`] by the type's own methods (inherent methods win
-/// over the trait's in the paths below).
-macro_rules! lanes_by_inherent {
-    ($t:ty, $n:literal $(, $unsafe:tt)?) => {
-        impl Lanes for $t {
-            type Array = [f32; $n];
-            const ALL: u32 = (1 << $n) - 1;
-            #[inline(always)]
-            unsafe fn splat(x: f32) -> Self {
-                // SAFETY: the trait's contract is the type's.
-                $($unsafe)? { <$t>::splat(x) }
-            }
-            #[inline(always)]
-            unsafe fn add(self, o: Self) -> Self {
-                // SAFETY: as above.
-                $($unsafe)? { <$t>::add(self, o) }
-            }
-            #[inline(always)]
-            unsafe fn sub(self, o: Self) -> Self {
-                // SAFETY: as above.
-                $($unsafe)? { <$t>::sub(self, o) }
-            }
-            #[inline(always)]
-            unsafe fn mul(self, o: Self) -> Self {
-                // SAFETY: as above.
-                $($unsafe)? { <$t>::mul(self, o) }
-            }
-            #[inline(always)]
-            unsafe fn div(self, o: Self) -> Self {
-                // SAFETY: as above.
-                $($unsafe)? { <$t>::div(self, o) }
-            }
-            #[inline(always)]
-            unsafe fn le_mask(self, o: Self) -> u32 {
-                // SAFETY: as above.
-                $($unsafe)? { <$t>::le_mask(self, o) }
-            }
-            #[inline(always)]
-            unsafe fn lt_mask(self, o: Self) -> u32 {
-                // SAFETY: as above.
-                $($unsafe)? { <$t>::lt_mask(self, o) }
-            }
-            #[inline(always)]
-            unsafe fn eq_mask(self, o: Self) -> u32 {
-                // SAFETY: as above.
-                $($unsafe)? { <$t>::eq_mask(self, o) }
-            }
-            #[inline(always)]
-            fn to_lanes(self) -> [f32; $n] {
-                self.to_array()
-            }
-        }
-    };
+/// [`F32x4`]'s own (safe) methods.
+impl Lanes for F32x4 {
+    type Array = [f32; 4];
+    const ALL: u32 = 0xf;
+    #[inline(always)]
+    unsafe fn splat(x: f32) -> Self {
+        F32x4::splat(x)
+    }
+    #[inline(always)]
+    unsafe fn add(self, o: Self) -> Self {
+        F32x4::add(self, o)
+    }
+    #[inline(always)]
+    unsafe fn sub(self, o: Self) -> Self {
+        F32x4::sub(self, o)
+    }
+    #[inline(always)]
+    unsafe fn mul(self, o: Self) -> Self {
+        F32x4::mul(self, o)
+    }
+    #[inline(always)]
+    unsafe fn div(self, o: Self) -> Self {
+        F32x4::div(self, o)
+    }
+    #[inline(always)]
+    unsafe fn le_mask(self, o: Self) -> u32 {
+        F32x4::le_mask(self, o)
+    }
+    #[inline(always)]
+    unsafe fn lt_mask(self, o: Self) -> u32 {
+        F32x4::lt_mask(self, o)
+    }
+    #[inline(always)]
+    unsafe fn eq_mask(self, o: Self) -> u32 {
+        F32x4::eq_mask(self, o)
+    }
+    #[inline(always)]
+    fn to_lanes(self) -> [f32; 4] {
+        self.to_array()
+    }
 }
-lanes_by_inherent!(F32x4, 4);
-#[cfg(target_arch = "x86_64")]
-lanes_by_inherent!(F32x8, 8, unsafe);
 
 /// Hints the CPU to start loading the cache lines of `bytes` bytes from
 /// `r` on (every line they touch, whatever `r`'s alignment).

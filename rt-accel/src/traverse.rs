@@ -660,7 +660,7 @@ pub(crate) unsafe fn box_lanes_avx<const NONNEG: bool>(
     ctx: &RayCtx,
     t_max: f32,
 ) -> (crate::simd::F32x8, crate::simd::F32x8) {
-    use crate::simd::F32x8;
+    use crate::simd::{F32x8, Lanes as _};
     use rt_core::internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG};
     const { assert!(GROUPS == 2) };
     let b = &node.bounds;
