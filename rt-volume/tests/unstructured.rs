@@ -7,7 +7,8 @@ mod support;
 
 use glam::DVec3;
 use rt_volume::{
-    Cell, Exit, GaussianBump, MeshError, SmoothField, TraceParams, UnstructuredField, trace,
+    Cell, Exit, GaussianBump, MeshError, SmoothField, TraceError, TraceParams, UnstructuredField,
+    trace,
 };
 use support::{Kind, Rng, box_boundary_triangles, box_mesh};
 
@@ -319,6 +320,18 @@ fn bad_meshes_are_errors() {
     // A ray that misses goes straight.
     let r = field.trace(DVec3::new(5.0, 5.0, 5.0), DVec3::X).unwrap();
     assert_eq!(r.exit, Exit::Missed);
+    // An ambient index of 5.5e303 over a stretch of 2.6e6: the optical path
+    // overflows, an error and not an infinite result (found by the fuzzer).
+    let points = vec![
+        DVec3::new(1e8, 1e8, -1e8),
+        DVec3::new(1e7, -2.375, -4.0),
+        DVec3::new(1.5625, 3.875, 2.0625),
+        DVec3::splat(3.875),
+    ];
+    let index = vec![1.0001, 1.0, 2.25, 0.996_187_5];
+    let huge = UnstructuredField::new(points, &[Cell::Tetra([3, 2, 0, 1])], index, 5.486e303);
+    let got = huge.unwrap().trace(DVec3::new(2.25, 2.25, 0.0), DVec3::new(1e7, 1.6875, 0.0));
+    assert!(matches!(got, Err(TraceError::BadField { .. })), "{got:?}");
 }
 
 /// Rays in the bump's symmetry planes `x = ±y`, where the hexahedra's split

@@ -320,6 +320,11 @@ impl UnstructuredField {
             };
             entered = true;
             opl += self.ambient * gap;
+            if !opl.is_finite() {
+                // A huge ambient index over a long straight stretch: the
+                // optical path overflows before the ray reaches the mesh.
+                return Err(TraceError::BadField { at: x0 });
+            }
             let (n0, _) = self.linear(tet0, x0);
             if !(n0.is_finite() && n0 > 0.0) {
                 return Err(TraceError::BadField { at: x0 });
@@ -382,6 +387,9 @@ impl UnstructuredField {
                     return Err(TraceError::BadField { at: cur });
                 }
                 opl += dopl;
+                if !opl.is_finite() {
+                    return Err(TraceError::BadField { at: x1 });
+                }
                 cur = x1;
                 tt = t1;
                 visit(cur);
