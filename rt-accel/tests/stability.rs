@@ -714,3 +714,57 @@ fn fuzz_regression_occluded_at_exactly_t_max() {
         assert_eq!(check_triangles(&bvh, &pos, &idx, &ray), Some((0.75, 0)), "{quality:?}");
     }
 }
+
+/// A flat grid of small squares far from the origin (`|o| ≈ 4·10⁴`), with
+/// rays from about one unit away aimed at its vertices and edge points:
+/// there `|o/d|` is 10⁴ times the hit distance, so a box test that rounds
+/// `o·(1/d)` on its own (`fma(b, 1/d, −o·(1/d))`, one instruction per
+/// plane) without a margin for it leaves boxes the exact test enters
+/// (tried: it fails here). Every kernel must answer as brute force does,
+/// and no ray may slip through the grid.
+#[test]
+fn grid_far_from_the_origin_hit_near_its_vertices() {
+    let n = 12;
+    let base = Vec3::new(1.1e4, -2.3e4, 3.7e4);
+    let mut pos = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            pos.push(base + Vec3::new(i as f32 * 0.37, j as f32 * 0.41, 0.0));
+        }
+    }
+    let at = |i: u32, j: u32| j * (n + 1) + i;
+    let mut idx = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            idx.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            idx.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    let bvh = build_triangles(&pos, &idx, &rt_accel::BuildParams { max_leaf_size: 1, ..params() })
+        .unwrap();
+    let mut rays = 0;
+    for j in 1..n {
+        for i in 1..n {
+            let v = pos[at(i, j) as usize];
+            let w = pos[at(i + 1, j) as usize];
+            for target in [v, (v + w) * 0.5, v + (w - v) * 0.3] {
+                for (k, off) in [
+                    Vec3::new(0.31, 0.17, 0.9),
+                    Vec3::new(-0.23, 0.29, -1.3),
+                    Vec3::new(0.07, -0.61, 0.45),
+                    Vec3::new(-1.9, -0.8, 2.1),
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    let eye = target + off;
+                    let r = Ray::new(eye, target - eye);
+                    let got = check_triangles(&bvh, &pos, &idx, &r);
+                    assert!(got.is_some(), "ray {k} from {eye} → {target} slipped through");
+                    rays += 1;
+                }
+            }
+        }
+    }
+    assert!(rays > 1000);
+}
