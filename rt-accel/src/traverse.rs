@@ -200,16 +200,14 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     /// constants are made here, inside the kernel, so they stay in
     /// registers: made by a separate call, they were stored and read back
     /// at once with loads wider than the stores, which the CPU cannot
-    /// forward (a tenth of a missed ray's time).
+    /// forward (a tenth of a missed ray's time). The tree must not be
+    /// empty: the root is read unchecked (`occluded_with` checks).
     #[inline(always)]
     fn occluded_kernel<const AVX: bool>(&self, ray: &Ray, stack: &mut TraversalStack) -> bool {
         let Some(ctx) = RayCtx::new(ray) else {
             return false;
         };
         let ctx = &ctx;
-        if self.nodes.is_empty() {
-            return false;
-        }
         let root = ChildRef::inner(0);
         if ctx.ray.t_min >= 0.0 {
             self.occluded_from::<AVX, true>(ctx, root, stack)

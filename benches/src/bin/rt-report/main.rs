@@ -42,9 +42,15 @@ use std::{io::Write as _, path::PathBuf, process::ExitCode};
 /// Where reports go: `$CARGO_TARGET_DIR/rt-report` or `target/rt-report` at
 /// the workspace root.
 fn out_dir() -> PathBuf {
+    // The workspace root is this package's parent folder (named as such,
+    // not as `benches/..`, in the paths the report prints).
+    let root = || {
+        let here = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        here.parent().map_or_else(|| here.join(".."), std::path::Path::to_path_buf)
+    };
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..").join("target"));
+        .unwrap_or_else(|| root().join("target"));
     target.join("rt-report")
 }
 
