@@ -320,11 +320,6 @@ impl UnstructuredField {
             };
             entered = true;
             opl += self.ambient * gap;
-            if !opl.is_finite() {
-                // A huge ambient index over a long straight stretch: the
-                // optical path overflows before the ray reaches the mesh.
-                return Err(TraceError::BadField { at: x0 });
-            }
             let (n0, _) = self.linear(tet0, x0);
             if !(n0.is_finite() && n0 > 0.0) {
                 return Err(TraceError::BadField { at: x0 });
@@ -387,9 +382,6 @@ impl UnstructuredField {
                     return Err(TraceError::BadField { at: cur });
                 }
                 opl += dopl;
-                if !opl.is_finite() {
-                    return Err(TraceError::BadField { at: x1 });
-                }
                 cur = x1;
                 tt = t1;
                 visit(cur);
@@ -417,6 +409,11 @@ impl UnstructuredField {
                 exit,
                 stats,
             });
+        }
+        if !opl.is_finite() {
+            // Every term is finite and positive, so the sum only overflows
+            // (a huge index over a long path, e.g. the ambient one).
+            return Err(TraceError::BadField { at: x });
         }
         Ok(TraceResult { position: x, direction: dir, optical_path: opl, exit, stats })
     }

@@ -44,13 +44,10 @@ use std::{io::Write as _, path::PathBuf, process::ExitCode};
 fn out_dir() -> PathBuf {
     // The workspace root is this package's parent folder (named as such,
     // not as `benches/..`, in the paths the report prints).
-    let root = || {
-        let here = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-        here.parent().map_or_else(|| here.join(".."), std::path::Path::to_path_buf)
-    };
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target"));
+    let here = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = here.parent().unwrap_or(here);
+    let target =
+        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
     target.join("rt-report")
 }
 
