@@ -1,5 +1,6 @@
 //! Building with obvhs (feature `obvhs`): PLOC + reinsertion + leaf
-//! collapse into a binary BVH, then conversion to the 8-wide layout.
+//! collapse into a binary BVH, then the 8-wide layout of least SAH cost
+//! over it (Ylitie et al. 2017's dynamic programming).
 //!
 //! obvhs stays at this edge: inputs and outputs are rt types.
 
@@ -146,21 +147,27 @@ pub fn build_triangles(
         }
     }
     let p = params.obvhs();
+    let max_leaf = p.max_prims_per_leaf;
     let bvh2 = if tris.is_empty() {
         None
     } else {
         Some(build_bvh2_from_tris(&tris, p, &mut Duration::default()))
     };
-    let (nodes, items) = convert(bvh2.as_ref(), |prims, items: &mut Vec<TriPacket>| {
-        for chunk in prims.chunks(4) {
-            let mut packet = TriPacket::EMPTY;
-            for (lane, &k) in chunk.iter().enumerate() {
-                let t = &tris[k as usize];
-                packet.set_lane(lane, ids[k as usize], [t.v0.into(), t.v1.into(), t.v2.into()]);
+    let (nodes, items) = convert(
+        bvh2.as_ref(),
+        max_leaf,
+        |n| n.div_ceil(4),
+        |prims, items: &mut Vec<TriPacket>| {
+            for chunk in prims.chunks(4) {
+                let mut packet = TriPacket::EMPTY;
+                for (lane, &k) in chunk.iter().enumerate() {
+                    let t = &tris[k as usize];
+                    packet.set_lane(lane, ids[k as usize], [t.v0.into(), t.v1.into(), t.v2.into()]);
+                }
+                items.push(packet);
             }
-            items.push(packet);
-        }
-    })?;
+        },
+    )?;
     let mut bvh = Bvh { nodes, items, prim_count };
     // The boxes from the items themselves: with spatial pre-splits (the
     // slow presets) obvhs's leaf boxes are clipped parts of a triangle's
@@ -235,9 +242,15 @@ fn build_items<P: Primitive>(prims: Vec<P>, params: &BuildParams) -> Result<Bvh<
     } else {
         Some(build_bvh2(&boxes, params.obvhs(), &mut Duration::default()))
     };
-    let (nodes, items) = convert(bvh2.as_ref(), |ids, items: &mut Vec<P>| {
-        items.extend(ids.iter().map(|&i| prims[i as usize]));
-    })?;
+    let max_leaf = params.obvhs().max_prims_per_leaf;
+    let (nodes, items) = convert(
+        bvh2.as_ref(),
+        max_leaf,
+        |n| n,
+        |ids, items: &mut Vec<P>| {
+            items.extend(ids.iter().map(|&i| prims[i as usize]));
+        },
+    )?;
     Ok(Bvh { nodes, items, prim_count })
 }
 
@@ -245,13 +258,152 @@ fn to_aabb(b: &obvhs::aabb::Aabb) -> Aabb {
     Aabb::new(b.min.into(), b.max.into())
 }
 
-/// Collapses a binary BVH into the 8-wide layout: each wide node takes its
-/// binary node's two children and repeatedly opens the inner child of
-/// largest surface area until it has [`WIDTH`]. Nodes are emitted breadth
-/// first (the order [`crate::validate`] checks), so children always follow
-/// their parent.
+/// Weights of the collapse's surface area heuristic: the cost of testing
+/// one wide node's boxes and of testing one leaf item, each times the
+/// surface area of the box that leads to it (the chance a ray gets there).
+const NODE_COST: f64 = 1.0;
+const ITEM_COST: f64 = 1.0;
+
+/// How a binary subtree is laid out among `s` child slots of a wide node.
+#[derive(Clone, Copy, Debug)]
+enum Choice {
+    /// One slot: a leaf holding every primitive of the subtree.
+    Leaf,
+    /// One slot: a wide node of its own.
+    Node,
+    /// The two binary children, over `left` and `right` slots.
+    Split { left: u8, right: u8 },
+}
+
+/// The cheapest layout of every binary subtree over 1 to [`WIDTH`] slots
+/// (Ylitie, Karras and Laine 2017, "Efficient incoherent ray traversal
+/// on GPUs through compressed wide BVHs", §4.1: dynamic programming over
+/// the binary tree, bottom up).
+struct Plan {
+    /// `choice[n][s − 1]`: the layout of subtree `n` over at most `s` slots.
+    choice: Vec<[Choice; WIDTH]>,
+    /// `wide[n]`: the children of the wide node made of inner node `n`,
+    /// its two binary children over all [`WIDTH`] slots.
+    wide: Vec<Choice>,
+}
+
+impl Plan {
+    /// `items(p)`: leaf items that `p` primitives take; a leaf holds at
+    /// most `max_leaf` primitives.
+    fn new(b2: &Bvh2, max_leaf: u32, items: impl Fn(u32) -> u32) -> Self {
+        let n = b2.nodes.len();
+        // In f64, from the boxes' f32 corners: every area and sum is
+        // finite (a box's extent may overflow f32), so every inner node
+        // finds a split.
+        let mut cost = alloc::vec![[f64::INFINITY; WIDTH]; n];
+        let mut choice = alloc::vec![[Choice::Leaf; WIDTH]; n];
+        let mut wide = alloc::vec![Choice::Leaf; n];
+        let mut prims = alloc::vec![0u32; n];
+        // Post order with an explicit stack (`true`: children done).
+        let mut stack = alloc::vec![(0usize, false)];
+        while let Some((i, done)) = stack.pop() {
+            let node = &b2.nodes[i];
+            let (lo, hi) = (node.aabb().min.as_dvec3(), node.aabb().max.as_dvec3());
+            let e = hi - lo;
+            let area = e.x * e.y + e.y * e.z + e.z * e.x;
+            let leaf_cost = |p: u32| area * ITEM_COST * f64::from(items(p));
+            if node.is_leaf() {
+                prims[i] = node.prim_count;
+                cost[i] = [leaf_cost(node.prim_count); WIDTH];
+                continue;
+            }
+            let (l, r) = (node.first_index as usize, node.first_index as usize + 1);
+            if !done {
+                stack.extend([(i, true), (l, false), (r, false)]);
+                continue;
+            }
+            prims[i] = prims[l].saturating_add(prims[r]);
+            // `split[s − 1]`: both children over exactly `s ≥ 2` slots.
+            let mut split = [(f64::INFINITY, Choice::Leaf); WIDTH];
+            for s in 2..=WIDTH {
+                for left in 1..s {
+                    let c = cost[l][left - 1] + cost[r][s - left - 1];
+                    if c < split[s - 1].0 {
+                        let (left, right) = (left as u8, (s - left) as u8);
+                        split[s - 1] = (c, Choice::Split { left, right });
+                    }
+                }
+            }
+            let leaf = if prims[i] <= max_leaf { leaf_cost(prims[i]) } else { f64::INFINITY };
+            let inner = area * NODE_COST + split[WIDTH - 1].0;
+            wide[i] = split[WIDTH - 1].1;
+            (cost[i][0], choice[i][0]) =
+                if leaf <= inner { (leaf, Choice::Leaf) } else { (inner, Choice::Node) };
+            for s in 1..WIDTH {
+                (cost[i][s], choice[i][s]) = if split[s].0 < cost[i][s - 1] {
+                    split[s]
+                } else {
+                    (cost[i][s - 1], choice[i][s - 1])
+                };
+            }
+        }
+        Self { choice, wide }
+    }
+
+    /// Appends the slots of subtree `n` laid out over at most `s` slots:
+    /// `(binary node, is leaf)`.
+    fn slots(&self, b2: &Bvh2, n: usize, s: usize, out: &mut Vec<(usize, bool)>) {
+        match self.choice[n][s - 1] {
+            Choice::Leaf => out.push((n, true)),
+            Choice::Node => out.push((n, false)),
+            Choice::Split { left, right } => {
+                let l = b2.nodes[n].first_index as usize;
+                self.slots(b2, l, usize::from(left), out);
+                self.slots(b2, l + 1, usize::from(right), out);
+            }
+        }
+    }
+
+    /// The children of the wide node made of binary node `n`.
+    fn children(&self, b2: &Bvh2, n: usize, out: &mut Vec<(usize, bool)>) {
+        out.clear();
+        match self.wide[n] {
+            Choice::Split { left, right } if !b2.nodes[n].is_leaf() => {
+                let l = b2.nodes[n].first_index as usize;
+                self.slots(b2, l, usize::from(left), out);
+                self.slots(b2, l + 1, usize::from(right), out);
+            }
+            // A binary leaf at the root: one leaf child.
+            _ => out.push((n, true)),
+        }
+    }
+
+    /// The primitives of subtree `n`, each once (with spatial splits a
+    /// primitive may sit in several of its binary leaves).
+    fn gather(b2: &Bvh2, n: usize, out: &mut Vec<u32>) {
+        out.clear();
+        let mut stack = alloc::vec![n];
+        while let Some(i) = stack.pop() {
+            let node = &b2.nodes[i];
+            if node.is_leaf() {
+                let start = node.first_index as usize;
+                out.extend_from_slice(
+                    &b2.primitive_indices[start..start + node.prim_count as usize],
+                );
+            } else {
+                stack.extend([node.first_index as usize + 1, node.first_index as usize]);
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+}
+
+/// Collapses a binary BVH into the 8-wide layout chosen by [`Plan`]: the
+/// layout of least SAH cost, which merges small subtrees into leaves and
+/// fills wide nodes where the binary tree allows. `items(p)` is the
+/// number of leaf items `p` primitives take; `emit_leaf` appends them.
+/// Nodes are emitted breadth first (the order [`crate::validate`]
+/// checks), so children always follow their parent.
 fn convert<P: Primitive>(
     bvh2: Option<&Bvh2>,
+    max_leaf: u32,
+    items_of: impl Fn(u32) -> u32,
     mut emit_leaf: impl FnMut(&[u32], &mut Vec<P>),
 ) -> Result<(Vec<Node>, Vec<P>), BuildError> {
     let mut nodes = Vec::new();
@@ -262,47 +414,27 @@ fn convert<P: Primitive>(
     if b2.nodes.is_empty() {
         return Ok((nodes, items));
     }
+    let plan = Plan::new(b2, max_leaf, items_of);
     nodes.push(Node::EMPTY);
     // `work[i]` = (binary node, depth) of wide node `i`; processing in index
     // order while appending children gives breadth-first order.
     let mut work = alloc::vec![(0usize, 1usize)];
     let mut dst = 0;
+    let (mut kids, mut prims) = (Vec::new(), Vec::new());
     while let Some(&(src, depth)) = work.get(dst) {
         if depth > MAX_DEPTH {
             return Err(BuildError::TooDeep);
         }
-        let n = &b2.nodes[src];
-        let mut kids: Vec<usize> = if n.is_leaf() {
-            alloc::vec![src]
-        } else {
-            alloc::vec![n.first_index as usize, n.first_index as usize + 1]
-        };
-        while kids.len() < WIDTH {
-            let open = kids
-                .iter()
-                .enumerate()
-                .filter(|(_, k)| !b2.nodes[**k].is_leaf())
-                .max_by(|a, b| {
-                    let (ha, hb) =
-                        (b2.nodes[*a.1].aabb().half_area(), b2.nodes[*b.1].aabb().half_area());
-                    ha.total_cmp(&hb)
-                })
-                .map(|(i, _)| i);
-            let Some(i) = open else { break };
-            let k = kids.swap_remove(i);
-            let first = b2.nodes[k].first_index as usize;
-            kids.push(first);
-            kids.push(first + 1);
-        }
+        plan.children(b2, src, &mut kids);
         let mut node = Node::EMPTY;
-        for (slot, &k) in kids.iter().enumerate() {
-            let kn = &b2.nodes[k];
-            node.set_child_bounds(slot, to_aabb(kn.aabb()));
-            node.children[slot] = if kn.is_leaf() {
-                let start = kn.first_index as usize;
-                let prims = &b2.primitive_indices[start..start + kn.prim_count as usize];
+        for (slot, &(k, is_leaf)) in kids.iter().enumerate() {
+            node.set_child_bounds(slot, to_aabb(b2.nodes[k].aabb()));
+            node.children[slot] = if is_leaf {
+                // At most the primitives `Plan` counted, so within the
+                // leaf size.
+                Plan::gather(b2, k, &mut prims);
                 let first = items.len();
-                emit_leaf(prims, &mut items);
+                emit_leaf(&prims, &mut items);
                 let count = items.len() - first;
                 if items.len() > MAX_ITEMS as usize {
                     return Err(BuildError::TooManyPrimitives);
@@ -322,4 +454,116 @@ fn convert<P: Primitive>(
         dst += 1;
     }
     Ok((nodes, items))
+}
+
+#[cfg(test)]
+mod tests {
+    use obvhs::{aabb::Aabb as OAabb, bvh2::node::Bvh2Node};
+
+    use super::*;
+
+    /// A balanced binary tree over leaves of one primitive each, primitive
+    /// `i` with box `boxes[i]`; `dup` adds the last but one primitive to the
+    /// last leaf too (as spatial splits do).
+    fn balanced(boxes: &[OAabb], dup: bool) -> Bvh2 {
+        fn node(b2: &mut Bvh2, boxes: &[OAabb], first: u32, slot: usize) {
+            if boxes.len() == 1 {
+                b2.nodes[slot] = Bvh2Node::new(boxes[0], 1, first);
+                return;
+            }
+            let kids = b2.nodes.len();
+            b2.nodes.extend([Bvh2Node::default(); 2]);
+            let mid = boxes.len() / 2;
+            node(b2, &boxes[..mid], first, kids);
+            node(b2, &boxes[mid..], first + mid as u32, kids + 1);
+            let aabb = b2.nodes[kids].aabb().union(b2.nodes[kids + 1].aabb());
+            b2.nodes[slot] = Bvh2Node::new(aabb, 0, kids as u32);
+        }
+        let mut b2 = Bvh2 { nodes: alloc::vec![Bvh2Node::default()], ..Bvh2::default() };
+        b2.primitive_indices = (0..boxes.len() as u32).collect();
+        node(&mut b2, boxes, 0, 0);
+        if dup {
+            let last = b2.nodes.iter().rposition(Bvh2Node::is_leaf).unwrap();
+            let n = boxes.len() as u32;
+            b2.primitive_indices.extend([n - 1, n - 2]);
+            b2.nodes[last] = Bvh2Node::new(*b2.nodes[last].aabb(), 2, n);
+        }
+        b2
+    }
+
+    fn unit_box(x: f32, y: f32) -> OAabb {
+        OAabb::new(Vec3A::new(x, y, 0.0), Vec3A::new(x + 1.0, y + 1.0, 1.0))
+    }
+
+    /// Collapses `b2` into triangle packets; the primitives of each leaf.
+    fn collapse(b2: &Bvh2, max_leaf: u32) -> (Vec<Node>, Vec<Vec<u32>>) {
+        let (nodes, items) = convert(
+            Some(b2),
+            max_leaf,
+            |n| n.div_ceil(4),
+            |prims, items| {
+                for chunk in prims.chunks(4) {
+                    let mut p = TriPacket::EMPTY;
+                    for (lane, &k) in chunk.iter().enumerate() {
+                        p.set_lane(lane, k, [Vec3::ZERO; 3]);
+                    }
+                    items.push(p);
+                }
+            },
+        )
+        .unwrap();
+        let leaves = nodes
+            .iter()
+            .flat_map(|n| n.children)
+            .filter(|c| c.is_leaf() && !c.is_empty())
+            .map(|c| {
+                let (first, count) = c.leaf_range();
+                items[first..first + count]
+                    .iter()
+                    .flat_map(|p| p.prims)
+                    .filter(|&k| k != u32::MAX)
+                    .collect()
+            })
+            .collect();
+        (nodes, leaves)
+    }
+
+    fn fill(n: &Node) -> usize {
+        n.children.iter().filter(|c| !c.is_empty()).count()
+    }
+
+    #[test]
+    fn sixty_four_far_apart_leaves_make_nine_full_nodes() {
+        // Far apart: merging any two into a leaf costs more than a slot.
+        let boxes: Vec<_> = (0..64).map(|i| unit_box(100.0 * i as f32, 0.0)).collect();
+        let (nodes, leaves) = collapse(&balanced(&boxes, false), 8);
+        assert_eq!(nodes.len(), 9);
+        assert!(nodes.iter().all(|n| fill(n) == WIDTH));
+        let mut prims: Vec<u32> = leaves.concat();
+        prims.sort_unstable();
+        assert_eq!(prims, (0..64).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn overlapping_leaves_merge_into_packets_up_to_the_leaf_size() {
+        // Sixteen copies of one box: a leaf of four costs one packet test
+        // over the same area as one of a single primitive.
+        let boxes = [unit_box(0.0, 0.0); 16];
+        let (nodes, leaves) = collapse(&balanced(&boxes, false), 4);
+        assert_eq!(nodes.len(), 1);
+        assert_eq!(fill(&nodes[0]), 4);
+        assert!(leaves.iter().all(|l| l.len() == 4), "{leaves:?}");
+        // With leaves of one, the same tree needs two levels.
+        let (nodes, leaves) = collapse(&balanced(&boxes, false), 1);
+        assert_eq!((nodes.len(), leaves.len()), (3, 16));
+    }
+
+    #[test]
+    fn a_primitive_in_two_merged_leaves_is_tested_once() {
+        // Leaves [0], [1] and [2, 1]: the root's second child, three
+        // primitives with 1 counted twice, is one packet and one leaf.
+        let boxes = [unit_box(0.0, 0.0); 3];
+        let (_, leaves) = collapse(&balanced(&boxes, true), 8);
+        assert_eq!(leaves, [alloc::vec![0], alloc::vec![1, 2]]);
+    }
 }
