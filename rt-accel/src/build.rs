@@ -258,10 +258,12 @@ fn to_aabb(b: &obvhs::aabb::Aabb) -> Aabb {
     Aabb::new(b.min.into(), b.max.into())
 }
 
-/// Weights of the collapse's surface area heuristic: the cost of testing
-/// one wide node's boxes and of testing one leaf item, each times the
-/// surface area of the box that leads to it (the chance a ray gets there).
+/// The collapse's surface area heuristic weighs every test by the surface
+/// area of the box that leads to it (the chance a ray gets there). This is
+/// the cost of testing one wide node's boxes.
 const NODE_COST: f64 = 1.0;
+/// The cost of testing one leaf item (four triangles, a sphere, a
+/// capsule). Weights of 0.5–2 against [`NODE_COST`] measured the same.
 const ITEM_COST: f64 = 1.0;
 
 /// How a binary subtree is laid out among `s` child slots of a wide node.
