@@ -237,12 +237,10 @@ fn build_items<P: Primitive>(prims: Vec<P>, params: &BuildParams) -> Result<Bvh<
             obvhs::aabb::Aabb::new(a3(b.min), a3(b.max))
         })
         .collect();
-    let bvh2 = if boxes.is_empty() {
-        None
-    } else {
-        Some(build_bvh2(&boxes, params.obvhs(), &mut Duration::default()))
-    };
-    let max_leaf = params.obvhs().max_prims_per_leaf;
+    let p = params.obvhs();
+    let max_leaf = p.max_prims_per_leaf;
+    let bvh2 =
+        if boxes.is_empty() { None } else { Some(build_bvh2(&boxes, p, &mut Duration::default())) };
     let (nodes, items) = convert(
         bvh2.as_ref(),
         max_leaf,
@@ -350,7 +348,12 @@ impl Plan {
     /// Appends the slots of subtree `n` laid out over at most `s` slots:
     /// `(binary node, is leaf)`.
     fn slots(&self, b2: &Bvh2, n: usize, s: usize, out: &mut Vec<(usize, bool)>) {
-        match self.choice[n][s - 1] {
+        self.place(b2, n, self.choice[n][s - 1], out);
+    }
+
+    /// Appends the slots of subtree `n` laid out as `c`.
+    fn place(&self, b2: &Bvh2, n: usize, c: Choice, out: &mut Vec<(usize, bool)>) {
+        match c {
             Choice::Leaf => out.push((n, true)),
             Choice::Node => out.push((n, false)),
             Choice::Split { left, right } => {
@@ -361,18 +364,12 @@ impl Plan {
         }
     }
 
-    /// The children of the wide node made of binary node `n`.
+    /// The children of the wide node made of binary node `n` (one leaf
+    /// for a binary leaf at the root).
     fn children(&self, b2: &Bvh2, n: usize, out: &mut Vec<(usize, bool)>) {
         out.clear();
-        match self.wide[n] {
-            Choice::Split { left, right } if !b2.nodes[n].is_leaf() => {
-                let l = b2.nodes[n].first_index as usize;
-                self.slots(b2, l, usize::from(left), out);
-                self.slots(b2, l + 1, usize::from(right), out);
-            }
-            // A binary leaf at the root: one leaf child.
-            _ => out.push((n, true)),
-        }
+        let c = if b2.nodes[n].is_leaf() { Choice::Leaf } else { self.wide[n] };
+        self.place(b2, n, c, out);
     }
 
     /// The primitives of subtree `n`, each once (with spatial splits a
