@@ -41,7 +41,8 @@ impl AlignedBytes {
     /// An aligned copy of `bytes`.
     #[must_use]
     pub fn copy_from(bytes: &[u8]) -> Self {
-        let mut lines = alloc::vec![Line([0; BYTES_ALIGN]); bytes.len().div_ceil(BYTES_ALIGN)];
+        // In memory advised for large pages, as an owned `Bvh`'s arrays.
+        let mut lines = crate::pages::large_zeroed(bytes.len().div_ceil(BYTES_ALIGN));
         bytemuck::cast_slice_mut::<Line, u8>(&mut lines)[..bytes.len()].copy_from_slice(bytes);
         Self { lines, len: bytes.len() }
     }

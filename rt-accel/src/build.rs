@@ -168,7 +168,7 @@ pub fn build_triangles(
             }
         },
     )?;
-    let mut bvh = Bvh { nodes, items, prim_count };
+    let mut bvh = Bvh::from_arrays(&nodes, &items, prim_count);
     // The boxes from the items themselves: with spatial pre-splits (the
     // slow presets) obvhs's leaf boxes are clipped parts of a triangle's
     // box, and a hit on the triangle's box boundary could fall outside
@@ -249,7 +249,7 @@ fn build_items<P: Primitive>(prims: Vec<P>, params: &BuildParams) -> Result<Bvh<
             items.extend(ids.iter().map(|&i| prims[i as usize]));
         },
     )?;
-    Ok(Bvh { nodes, items, prim_count })
+    Ok(Bvh::from_arrays(&nodes, &items, prim_count))
 }
 
 fn to_aabb(b: &obvhs::aabb::Aabb) -> Aabb {

@@ -8,6 +8,7 @@ use crate::{
     BuildError, LoadError,
     bytes::{Header, parse, validate},
     node::{ChildRef, Node, WIDTH},
+    pages::large_copy,
     prim::{BestHit, Primitive},
     traverse::BvhRef,
 };
@@ -27,6 +28,12 @@ impl<P: Primitive> Bvh<P> {
     #[must_use]
     pub fn empty() -> Self {
         Self { nodes: Vec::new(), items: Vec::new(), prim_count: 0 }
+    }
+
+    /// A BVH of copies of `nodes` and `items` in memory advised for large
+    /// pages (see `pages.rs`: incoherent rays +9–14 % on Linux).
+    pub(crate) fn from_arrays(nodes: &[Node], items: &[P], prim_count: u32) -> Self {
+        Self { nodes: large_copy(nodes), items: large_copy(items), prim_count }
     }
 
     /// The borrowed view used for traversal.
@@ -139,7 +146,7 @@ impl<P: Primitive> Bvh<P> {
         let nodes: Vec<Node> = bytemuck::pod_collect_to_vec(&bytes[nr]);
         let items: Vec<P> = bytemuck::pod_collect_to_vec(&bytes[ir]);
         validate(&nodes, &items, h.prim_count)?;
-        Ok(Self { nodes, items, prim_count: h.prim_count })
+        Ok(Self::from_arrays(&nodes, &items, h.prim_count))
     }
 
     /// Recomputes every box bottom-up after `update` has rewritten the leaf

@@ -65,6 +65,8 @@ mod isa;
 mod mesh;
 mod node;
 mod packet;
+#[cfg(feature = "alloc")]
+mod pages;
 mod prim;
 mod ray_ctx;
 #[cfg(feature = "alloc")]
