@@ -10,14 +10,18 @@
 //! Slusallek, Benthin & Wagner 2001, "Interactive rendering with coherent
 //! ray tracing"), here on the 8-wide tree.
 //!
-//! Every ray's answer equals its single-ray query, bit for bit: each lane
-//! of the box test does the single-ray test's arithmetic in the same order
-//! (the NaN rule included), a ray enters a child only if its own test
-//! passes, a subtree is skipped for a ray only where its single-ray
-//! traversal would skip it too, and the closest hit does not depend on the
-//! order hits are found (ties go to the lower primitive index). A packet
-//! may visit a node for one ray that another ray did not need; that costs
-//! time, never a different answer.
+//! Every ray's answer equals its single-ray query, bit for bit: each
+//! lane's box test is conservative as the single-ray test is (it enters
+//! every box the ray meets within its range, rounding included; Ize 2013,
+//! with the NaN rule of a ray in a slab plane), a ray enters a child only
+//! if its own test passes, so both traversals test every primitive that
+//! can hold the closest hit, and that hit does not depend on the order
+//! hits are found (ties go to the lower primitive index). The two box
+//! tests widen the far distance in different places (the single-ray one
+//! in its reciprocal, for rays with `t_min ≥ 0`), so either may enter a
+//! box the other skips by a rounding. A packet may also visit a node for
+//! one ray that another ray did not need. Both cost time, never a
+//! different answer.
 
 use core::mem::MaybeUninit;
 

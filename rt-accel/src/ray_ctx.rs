@@ -4,9 +4,25 @@ use rt_core::{Ray, internal::widen_far, intersect::WatertightRay};
 
 use crate::simd::F32x4;
 
+/// `1 + 8u` (`u = 2⁻²⁴`, exact in f32): the factor on the reciprocal
+/// direction that makes the far slab distances of rays with `t_min ≥ 0`
+/// conservative without a multiply per node (Embree's robust kernels
+/// scale their reciprocal the same way).
+///
+/// The far distance `(b − o)/d` is computed as `fl(fl(b − o) · fl(fl(1/d)
+/// · S))`: four roundings, so for an exact distance `T₁ ≥ 0` the result is
+/// at least `T₁·S·(1 − u)⁴`, while the near distance, with three roundings,
+/// is at most `T₀·(1 + u)³` for `T₀ ≥ 0`. A box the ray enters (`T₀ ≤ T₁`)
+/// passes `t₀ ≤ t₁` whenever `S·(1 − u)⁴ ≥ (1 + u)³`, which `S = 1 + 8u`
+/// meets (`1 + 4u − O(u²)` against `1 + 3u + O(u²)`). A negative `T₁` is
+/// computed negative (rounding keeps signs), below any `t₀ ≥ t_min ≥ 0`:
+/// such boxes are behind the ray both ways. Rays with `t_min < 0` keep the
+/// signed widening of the far distance ([`rt_core::internal::widen_far`]).
+pub(crate) const FAR_INV_SCALE: f32 = 1.0 + 8.0 * (f32::EPSILON * 0.5);
+
 /// Everything a traversal precomputes once per ray: the reciprocal
 /// direction, the near/far plane selection by direction sign, and the
-/// watertight triangle shear. Scalars only (80 bytes): kernels broadcast
+/// watertight triangle shear. Scalars only (92 bytes): kernels broadcast
 /// them into SIMD lanes where they use them, which costs one load each,
 /// while splatting them here made the context five times larger and its
 /// construction a third of a missed ray's cost.
@@ -15,6 +31,9 @@ pub struct RayCtx {
     pub(crate) ray: Ray,
     /// Reciprocal direction per axis (`±∞` for `±0`).
     pub(crate) inv1: glam::Vec3,
+    /// `inv1 · FAR_INV_SCALE`: the far planes of rays with `t_min ≥ 0`
+    /// (see [`FAR_INV_SCALE`]).
+    pub(crate) inv_far: glam::Vec3,
     /// Row of `Node::bounds` holding the near plane per axis (by sign bit).
     pub(crate) near: [u8; 3],
     /// Row holding the far plane per axis.
@@ -49,6 +68,7 @@ impl RayCtx {
         Some(Self {
             ray: *ray,
             inv1: d.recip(),
+            inv_far: d.recip() * FAR_INV_SCALE,
             near: [nx, ny, nz],
             far: [fx, fy, fz],
             wt,
@@ -66,6 +86,12 @@ impl RayCtx {
     #[inline(always)]
     pub(crate) fn inv4(&self, a: usize) -> F32x4 {
         F32x4::splat(self.inv1[a])
+    }
+
+    /// The far planes' reciprocal per axis (see [`FAR_INV_SCALE`]), splatted.
+    #[inline(always)]
+    pub(crate) fn inv_far4(&self, a: usize) -> F32x4 {
+        F32x4::splat(self.inv_far[a])
     }
 
     /// [`rt_core::Aabb::admits_hit`] for the box `lo..hi` and this ray,
