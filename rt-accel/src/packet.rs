@@ -49,6 +49,11 @@ struct Lanes {
     ctx: [Option<RayCtx>; PACKET],
     org: [[f32; PACKET]; 3],
     inv: [[f32; PACKET]; 3],
+    /// The far planes' reciprocals ([`RayCtx`]'s, widened).
+    inv_far: [[f32; PACKET]; 3],
+    /// Whether every valid ray has `t_min ≥ 0`: the box tests then use
+    /// `inv_far` and skip the signed widening, as the single-ray test does.
+    nonneg: bool,
     /// The direction's sign per axis and ray as a lane mask: −0.0 (sign
     /// bit set) where the direction's sign bit is set, else 0.0.
     neg_mask: [[f32; PACKET]; 3],
@@ -71,6 +76,8 @@ impl Lanes {
             ctx,
             org: [[0.0; PACKET]; 3],
             inv: [[0.0; PACKET]; 3],
+            inv_far: [[0.0; PACKET]; 3],
+            nonneg: true,
             neg_mask: [[0.0; PACKET]; 3],
             t_min: [0.0; PACKET],
             valid: 0,
@@ -81,10 +88,12 @@ impl Lanes {
                 for a in 0..3 {
                     l.org[a][r] = c.ray.origin[a];
                     l.inv[a][r] = c.inv1[a];
+                    l.inv_far[a][r] = c.inv_far[a];
                     let neg = c.ray.direction[a].is_sign_negative();
                     l.neg_mask[a][r] = if neg { -0.0 } else { 0.0 };
                 }
                 l.t_min[r] = c.ray.t_min;
+                l.nonneg &= c.ray.t_min >= 0.0;
             }
         }
         l
@@ -104,8 +113,9 @@ fn min(x: f32, y: f32) -> f32 {
 }
 
 /// The rays of a packet that enter child `c` of `node` within their own
-/// `t_max` (one bit each), and their entry distances: per ray, exactly the
-/// single-ray box test's arithmetic.
+/// `t_max` (one bit each), and their entry distances: per ray, the
+/// single-ray box test's arithmetic (with the far planes widened in the
+/// reciprocal where every ray has `t_min ≥ 0`, else after the minimum).
 #[inline(always)]
 fn child_test(node: &Node, c: usize, l: &Lanes, t_max: &[f32; PACKET]) -> (u32, [f32; PACKET]) {
     let (g, k) = (c / 4, c % 4);
@@ -117,14 +127,19 @@ fn child_test(node: &Node, c: usize, l: &Lanes, t_max: &[f32; PACKET]) -> (u32, 
             let (lo, hi) = (b[2 * a][g][k], b[2 * a + 1][g][k]);
             let neg = l.neg_mask[a][r].is_sign_negative();
             let (near, far) = if neg { (hi, lo) } else { (lo, hi) };
-            ((near - l.org[a][r]) * l.inv[a][r], (far - l.org[a][r]) * l.inv[a][r])
+            let inv_far = if l.nonneg { l.inv_far[a][r] } else { l.inv[a][r] };
+            ((near - l.org[a][r]) * l.inv[a][r], (far - l.org[a][r]) * inv_far)
         };
         let (nx, fx) = slab(0);
         let (ny, fy) = slab(1);
         let (nz, fz) = slab(2);
         t0[r] = max(nx, max(ny, max(nz, l.t_min[r])));
-        let f = min(fx, min(fy, min(fz, f32::INFINITY)));
-        t1[r] = min(max(f * SLAB_FAR_SCALE, f * SLAB_FAR_SCALE_NEG), t_max[r]);
+        t1[r] = if l.nonneg {
+            min(fx, min(fy, min(fz, t_max[r])))
+        } else {
+            let f = min(fx, min(fy, min(fz, f32::INFINITY)));
+            min(max(f * SLAB_FAR_SCALE, f * SLAB_FAR_SCALE_NEG), t_max[r])
+        };
     }
     let mut mask = 0;
     for r in 0..PACKET {
@@ -157,7 +172,8 @@ unsafe fn child_test_avx(
             let neg = F32x8::from_array(l.neg_mask[a]);
             let (near, far) = (lo.blend(hi, neg), hi.blend(lo, neg));
             let (o, inv) = (F32x8::from_array(l.org[a]), F32x8::from_array(l.inv[a]));
-            (near.sub(o).mul(inv), far.sub(o).mul(inv))
+            let inv_far = F32x8::from_array(if l.nonneg { l.inv_far[a] } else { l.inv[a] });
+            (near.sub(o).mul(inv), far.sub(o).mul(inv_far))
         }
     }
     // SAFETY: the caller guarantees AVX.
@@ -166,6 +182,10 @@ unsafe fn child_test_avx(
         let (ny, fy) = slab(b[2][g][k], b[3][g][k], l, 1);
         let (nz, fz) = slab(b[4][g][k], b[5][g][k], l, 2);
         let t0 = nx.max(ny.max(nz.max(F32x8::from_array(l.t_min))));
+        if l.nonneg {
+            let t1 = fx.min(fy.min(fz.min(F32x8::from_array(*t_max))));
+            return (t0.le_mask(t1), t0.to_array());
+        }
         let t1 = fx.min(fy.min(fz.min(F32x8::splat(f32::INFINITY))));
         let t1 = t1
             .mul(F32x8::splat(SLAB_FAR_SCALE))
