@@ -10,18 +10,14 @@
 //! Slusallek, Benthin & Wagner 2001, "Interactive rendering with coherent
 //! ray tracing"), here on the 8-wide tree.
 //!
-//! Every ray's answer equals its single-ray query, bit for bit: each
-//! lane's box test is conservative as the single-ray test is (it enters
-//! every box the ray meets within its range, rounding included; Ize 2013,
-//! with the NaN rule of a ray in a slab plane), a ray enters a child only
-//! if its own test passes, so both traversals test every primitive that
-//! can hold the closest hit, and that hit does not depend on the order
-//! hits are found (ties go to the lower primitive index). The two box
-//! tests widen the far distance in different places (the single-ray one
-//! in its reciprocal, for rays with `t_min ≥ 0`), so either may enter a
-//! box the other skips by a rounding. A packet may also visit a node for
-//! one ray that another ray did not need. Both cost time, never a
-//! different answer.
+//! Every ray's answer equals its single-ray query, bit for bit: each lane
+//! of the box test does the single-ray test's arithmetic in the same order
+//! (the NaN rule included), a ray enters a child only if its own test
+//! passes, a subtree is skipped for a ray only where its single-ray
+//! traversal would skip it too, and the closest hit does not depend on the
+//! order hits are found (ties go to the lower primitive index). A packet
+//! may visit a node for one ray that another ray did not need; that costs
+//! time, never a different answer.
 
 use core::mem::MaybeUninit;
 
@@ -33,7 +29,6 @@ use crate::{
     prim::{BestHit, Primitive, any_leaf, closest_leaf},
     traverse::{BvhRef, STACK_SIZE, TraversalStack, TraversalStats},
 };
-use rt_core::internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG};
 
 /// Rays in a packet.
 pub const PACKET: usize = 8;
@@ -49,10 +44,14 @@ struct Lanes {
     ctx: [Option<RayCtx>; PACKET],
     org: [[f32; PACKET]; 3],
     inv: [[f32; PACKET]; 3],
-    /// The far planes' reciprocals ([`RayCtx`]'s, widened).
+    /// The far planes' reciprocals ([`RayCtx`]'s).
     inv_far: [[f32; PACKET]; 3],
-    /// Whether every valid ray has `t_min ≥ 0`: the box tests then use
-    /// `inv_far` and skip the signed widening, as the single-ray test does.
+    /// The far-distance widening factors ([`RayCtx`]'s `far_up`,
+    /// `far_down`).
+    far_up: [f32; PACKET],
+    far_down: [f32; PACKET],
+    /// Whether every valid ray has `t_min ≥ 0`: the box tests then skip
+    /// the widening factors (all 1), as the single-ray test does.
     nonneg: bool,
     /// The direction's sign per axis and ray as a lane mask: −0.0 (sign
     /// bit set) where the direction's sign bit is set, else 0.0.
@@ -77,6 +76,8 @@ impl Lanes {
             org: [[0.0; PACKET]; 3],
             inv: [[0.0; PACKET]; 3],
             inv_far: [[0.0; PACKET]; 3],
+            far_up: [1.0; PACKET],
+            far_down: [1.0; PACKET],
             nonneg: true,
             neg_mask: [[0.0; PACKET]; 3],
             t_min: [0.0; PACKET],
@@ -93,6 +94,7 @@ impl Lanes {
                     l.neg_mask[a][r] = if neg { -0.0 } else { 0.0 };
                 }
                 l.t_min[r] = c.ray.t_min;
+                (l.far_up[r], l.far_down[r]) = (c.far_up, c.far_down);
                 l.nonneg &= c.ray.t_min >= 0.0;
             }
         }
@@ -113,9 +115,8 @@ fn min(x: f32, y: f32) -> f32 {
 }
 
 /// The rays of a packet that enter child `c` of `node` within their own
-/// `t_max` (one bit each), and their entry distances: per ray, the
-/// single-ray box test's arithmetic (with the far planes widened in the
-/// reciprocal where every ray has `t_min ≥ 0`, else after the minimum).
+/// `t_max` (one bit each), and their entry distances: per ray, exactly the
+/// single-ray box test's arithmetic.
 #[inline(always)]
 fn child_test(node: &Node, c: usize, l: &Lanes, t_max: &[f32; PACKET]) -> (u32, [f32; PACKET]) {
     let (g, k) = (c / 4, c % 4);
@@ -127,8 +128,7 @@ fn child_test(node: &Node, c: usize, l: &Lanes, t_max: &[f32; PACKET]) -> (u32, 
             let (lo, hi) = (b[2 * a][g][k], b[2 * a + 1][g][k]);
             let neg = l.neg_mask[a][r].is_sign_negative();
             let (near, far) = if neg { (hi, lo) } else { (lo, hi) };
-            let inv_far = if l.nonneg { l.inv_far[a][r] } else { l.inv[a][r] };
-            ((near - l.org[a][r]) * l.inv[a][r], (far - l.org[a][r]) * inv_far)
+            ((near - l.org[a][r]) * l.inv[a][r], (far - l.org[a][r]) * l.inv_far[a][r])
         };
         let (nx, fx) = slab(0);
         let (ny, fy) = slab(1);
@@ -138,7 +138,7 @@ fn child_test(node: &Node, c: usize, l: &Lanes, t_max: &[f32; PACKET]) -> (u32, 
             min(fx, min(fy, min(fz, t_max[r])))
         } else {
             let f = min(fx, min(fy, min(fz, f32::INFINITY)));
-            min(max(f * SLAB_FAR_SCALE, f * SLAB_FAR_SCALE_NEG), t_max[r])
+            min(max(f * l.far_up[r], f * l.far_down[r]), t_max[r])
         };
     }
     let mut mask = 0;
@@ -172,7 +172,7 @@ unsafe fn child_test_avx(
             let neg = F32x8::from_array(l.neg_mask[a]);
             let (near, far) = (lo.blend(hi, neg), hi.blend(lo, neg));
             let (o, inv) = (F32x8::from_array(l.org[a]), F32x8::from_array(l.inv[a]));
-            let inv_far = F32x8::from_array(if l.nonneg { l.inv_far[a] } else { l.inv[a] });
+            let inv_far = F32x8::from_array(l.inv_far[a]);
             (near.sub(o).mul(inv), far.sub(o).mul(inv_far))
         }
     }
@@ -188,8 +188,8 @@ unsafe fn child_test_avx(
         }
         let t1 = fx.min(fy.min(fz.min(F32x8::splat(f32::INFINITY))));
         let t1 = t1
-            .mul(F32x8::splat(SLAB_FAR_SCALE))
-            .max(t1.mul(F32x8::splat(SLAB_FAR_SCALE_NEG)))
+            .mul(F32x8::from_array(l.far_up))
+            .max(t1.mul(F32x8::from_array(l.far_down)))
             .min(F32x8::from_array(*t_max));
         (t0.le_mask(t1), t0.to_array())
     }

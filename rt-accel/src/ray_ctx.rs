@@ -1,28 +1,16 @@
 //! Per-ray constants shared by the box tests and the leaf tests.
 
-use rt_core::{Ray, internal::widen_far, intersect::WatertightRay};
+use rt_core::{
+    Ray,
+    internal::{FAR_INV_SCALE, SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG, widen_far},
+    intersect::WatertightRay,
+};
 
 use crate::simd::F32x4;
 
-/// `1 + 8u` (`u = 2⁻²⁴`, exact in f32): the factor on the reciprocal
-/// direction that makes the far slab distances of rays with `t_min ≥ 0`
-/// conservative without a multiply per node (Embree's robust kernels
-/// scale their reciprocal the same way).
-///
-/// The far distance `(b − o)/d` is computed as `fl(fl(b − o) · fl(fl(1/d)
-/// · S))`: four roundings, so for an exact distance `T₁ ≥ 0` the result is
-/// at least `T₁·S·(1 − u)⁴`, while the near distance, with three roundings,
-/// is at most `T₀·(1 + u)³` for `T₀ ≥ 0`. A box the ray enters (`T₀ ≤ T₁`)
-/// passes `t₀ ≤ t₁` whenever `S·(1 − u)⁴ ≥ (1 + u)³`, which `S = 1 + 8u`
-/// meets (`1 + 4u − O(u²)` against `1 + 3u + O(u²)`). A negative `T₁` is
-/// computed negative (rounding keeps signs), below any `t₀ ≥ t_min ≥ 0`:
-/// such boxes are behind the ray both ways. Rays with `t_min < 0` keep the
-/// signed widening of the far distance ([`rt_core::internal::widen_far`]).
-pub(crate) const FAR_INV_SCALE: f32 = 1.0 + 8.0 * (f32::EPSILON * 0.5);
-
 /// Everything a traversal precomputes once per ray: the reciprocal
 /// direction, the near/far plane selection by direction sign, and the
-/// watertight triangle shear. Scalars only (92 bytes): kernels broadcast
+/// watertight triangle shear. Scalars only (100 bytes): kernels broadcast
 /// them into SIMD lanes where they use them, which costs one load each,
 /// while splatting them here made the context five times larger and its
 /// construction a third of a missed ray's cost.
@@ -31,9 +19,17 @@ pub struct RayCtx {
     pub(crate) ray: Ray,
     /// Reciprocal direction per axis (`±∞` for `±0`).
     pub(crate) inv1: glam::Vec3,
-    /// `inv1 · FAR_INV_SCALE`: the far planes of rays with `t_min ≥ 0`
-    /// (see [`FAR_INV_SCALE`]).
+    /// The far planes' reciprocal: `inv1 · FAR_INV_SCALE` for rays with
+    /// `t_min ≥ 0` ([`rt_core::internal::FAR_INV_SCALE`]), else `inv1`.
     pub(crate) inv_far: glam::Vec3,
+    /// The factors that widen the smallest far distance upward and
+    /// downward (`max` of the two products, [`widen_far`]): the Ize
+    /// scales for rays with `t_min < 0`, `1` for the others (whose far
+    /// distances are widened by `inv_far` already). Box tests that do not
+    /// know a ray's kind use them; those that know skip them (`NONNEG`).
+    pub(crate) far_up: f32,
+    /// See `far_up`.
+    pub(crate) far_down: f32,
     /// Row of `Node::bounds` holding the near plane per axis (by sign bit).
     pub(crate) near: [u8; 3],
     /// Row holding the far plane per axis.
@@ -64,11 +60,14 @@ impl RayCtx {
         let (ny, fy) = sel(1);
         let (nz, fz) = sel(2);
         let wt = WatertightRay::new(ray);
+        let nonneg = ray.t_min >= 0.0;
         let [kx, ky, kz] = wt.axes;
         Some(Self {
             ray: *ray,
             inv1: d.recip(),
-            inv_far: d.recip() * FAR_INV_SCALE,
+            inv_far: if nonneg { d.recip() * FAR_INV_SCALE } else { d.recip() },
+            far_up: if nonneg { 1.0 } else { SLAB_FAR_SCALE },
+            far_down: if nonneg { 1.0 } else { SLAB_FAR_SCALE_NEG },
             near: [nx, ny, nz],
             far: [fx, fy, fz],
             wt,
@@ -101,12 +100,14 @@ impl RayCtx {
     #[must_use]
     pub(crate) fn admits_hit(&self, lo: glam::Vec3, hi: glam::Vec3, t: f32) -> bool {
         let (o, d) = (self.ray.origin, self.ray.direction);
+        let nonneg = self.ray.t_min >= 0.0;
         let mut t0 = self.ray.t_min;
         let mut t1 = widen_far(t);
         for a in 0..3 {
             let (near, far) = if d[a].is_sign_negative() { (hi[a], lo[a]) } else { (lo[a], hi[a]) };
             let near = (near - o[a]) * self.inv1[a];
-            let far = widen_far((far - o[a]) * self.inv1[a]);
+            let far = (far - o[a]) * self.inv_far[a];
+            let far = if nonneg { far } else { widen_far(far) };
             // `x > t0` is false for NaN, so NaN leaves the bound alone.
             if near > t0 {
                 t0 = near;

@@ -563,16 +563,20 @@ unsafe fn push_hit_children(out: *mut MaybeUninit<ChildRef>, node: &Node, mask: 
 
 /// The node test of kernel `AVX` (see [`box_test_avx`]) or the 4-wide one.
 ///
-/// `NONNEG`: the ray has `t_min ≥ 0` (the single-ray kernels pick it per
-/// ray). Its far distances are computed with the reciprocal scaled by
-/// [`crate::ray_ctx::FAR_INV_SCALE`], which widens them as far as the
-/// rounding of both distances needs, and `t_max` joins them in one
-/// minimum: the mask is `t0 ≤ min(t1x, t1y, t1z, t_max)`, one compare.
-/// Other rays widen the far distance by its sign after the minimum
-/// ([`rt_core::internal::widen_far`]): a multiply per sign, three compares
-/// and two logical operations. The shorter form measured +2–5 % on every
-/// single-ray row (interleaved probe runs, best of 4), and an earlier
-/// step towards it, dropping only the downward comparison, +3–4 %.
+/// The test is the primitives' own box check's arithmetic
+/// ([`rt_core::Aabb::admits_hit`]), lane for lane, which is why a BVH
+/// finds exactly a brute-force loop's hits. Rays with `t_min ≥ 0` compute
+/// their far distances with the reciprocal scaled by
+/// [`rt_core::internal::FAR_INV_SCALE`]; other rays widen the smallest far
+/// distance by its sign ([`rt_core::internal::widen_far`]), through the
+/// ray's `far_up` and `far_down` (both 1 for the first kind, so the
+/// general form is right for every ray).
+///
+/// `NONNEG`: the caller knows the ray has `t_min ≥ 0` (the single-ray
+/// kernels pick it per ray), and the mask is one compare, `t0 ≤ min(t1x,
+/// t1y, t1z, t_max)`, instead of two multiplies, three compares and two
+/// logical operations. The shorter form measured +2–5 % on every
+/// single-ray row (interleaved probe runs, best of 4).
 #[inline(always)]
 pub(crate) fn box_test<const AVX: bool, const NONNEG: bool>(
     node: &Node,
@@ -595,7 +599,6 @@ pub(crate) fn box_test<const AVX: bool, const NONNEG: bool>(
 #[inline(always)]
 fn box_test_x4<const NONNEG: bool>(node: &Node, ctx: &RayCtx, t_max: f32) -> (u32, [f32; WIDTH]) {
     use crate::simd::F32x4;
-    use rt_core::internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG};
     let b = &node.bounds;
     let t_max = F32x4::splat(t_max);
     let mut mask = 0;
@@ -605,8 +608,7 @@ fn box_test_x4<const NONNEG: bool>(node: &Node, ctx: &RayCtx, t_max: f32) -> (u3
             let (near, far) = ctx.planes(b, a);
             let o = ctx.org4(a);
             let near = F32x4::from_array(near[g]).sub(o).mul(ctx.inv4(a));
-            let inv_far = if NONNEG { ctx.inv_far4(a) } else { ctx.inv4(a) };
-            let far = F32x4::from_array(far[g]).sub(o).mul(inv_far);
+            let far = F32x4::from_array(far[g]).sub(o).mul(ctx.inv_far4(a));
             (near, far)
         };
         let (nx, fx) = slab(0);
@@ -619,11 +621,11 @@ fn box_test_x4<const NONNEG: bool>(node: &Node, ctx: &RayCtx, t_max: f32) -> (u3
             t0.le_mask(fx.min(fy.min(fz.min(t_max))))
         } else {
             let t1 = fx.min(fy.min(fz.min(F32x4::splat(f32::INFINITY))));
-            // Widen outward whatever the sign (rt_core::internal::widen_far):
-            // `t0 ≤ min(max(t1·up, t1·down), t_max)` as three compares (no
-            // value is NaN), as the AVX kernels do.
-            let (up, down) =
-                (t1.mul(F32x4::splat(SLAB_FAR_SCALE)), t1.mul(F32x4::splat(SLAB_FAR_SCALE_NEG)));
+            // Widen outward whatever the sign (rt_core::internal::widen_far;
+            // by 1 where `inv_far` widened already): `t0 ≤ min(max(t1·up,
+            // t1·down), t_max)` as three compares (no value is NaN), as the
+            // AVX kernels do.
+            let (up, down) = (t1.mul(F32x4::splat(ctx.far_up)), t1.mul(F32x4::splat(ctx.far_down)));
             (t0.le_mask(up) | t0.le_mask(down)) & t0.le_mask(t_max)
         };
         mask |= m << (4 * g);
@@ -664,22 +666,17 @@ pub(crate) unsafe fn box_lanes_avx<const NONNEG: bool>(
     t_max: f32,
 ) -> (crate::simd::F32x8, crate::simd::F32x8) {
     use crate::simd::{F32x8, Lanes as _};
-    use rt_core::internal::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG};
     const { assert!(GROUPS == 2) };
     let b = &node.bounds;
     // Near and far distances to the planes of axis `a` (a function, not a
     // closure: closures are not always inlined, and an out-of-line call
     // would pass the 256-bit lanes through memory).
     #[inline(always)]
-    unsafe fn slab<const NONNEG: bool>(
-        b: &[[[f32; 4]; 2]; 6],
-        ctx: &RayCtx,
-        a: usize,
-    ) -> (F32x8, F32x8) {
+    unsafe fn slab(b: &[[[f32; 4]; 2]; 6], ctx: &RayCtx, a: usize) -> (F32x8, F32x8) {
         // SAFETY: the caller guarantees AVX.
         unsafe {
             let (o, inv) = (F32x8::splat(ctx.ray.origin[a]), F32x8::splat(ctx.inv1[a]));
-            let inv_far = if NONNEG { F32x8::splat(ctx.inv_far[a]) } else { inv };
+            let inv_far = F32x8::splat(ctx.inv_far[a]);
             let (near, far) = ctx.planes(b, a);
             let near = F32x8::from_groups(*near).sub(o).mul(inv);
             let far = F32x8::from_groups(*far).sub(o).mul(inv_far);
@@ -688,9 +685,9 @@ pub(crate) unsafe fn box_lanes_avx<const NONNEG: bool>(
     }
     // SAFETY: the caller guarantees AVX.
     unsafe {
-        let (nx, fx) = slab::<NONNEG>(b, ctx, 0);
-        let (ny, fy) = slab::<NONNEG>(b, ctx, 1);
-        let (nz, fz) = slab::<NONNEG>(b, ctx, 2);
+        let (nx, fx) = slab(b, ctx, 0);
+        let (ny, fy) = slab(b, ctx, 1);
+        let (nz, fz) = slab(b, ctx, 2);
         let t0 = nx.max(ny.max(nz.max(F32x8::splat(ctx.ray.t_min))));
         if NONNEG {
             // The far distances are widened already (`FAR_INV_SCALE`).
@@ -699,8 +696,8 @@ pub(crate) unsafe fn box_lanes_avx<const NONNEG: bool>(
         let t1 = fx.min(fy.min(fz.min(F32x8::splat(f32::INFINITY))));
         // `t0 ≤ min(max(t1·up, t1·down), t_max)` as three compares side by
         // side (none of the values is NaN: the same mask, a shorter chain).
-        let up = t1.mul(F32x8::splat(SLAB_FAR_SCALE));
-        let down = t1.mul(F32x8::splat(SLAB_FAR_SCALE_NEG));
+        let up = t1.mul(F32x8::splat(ctx.far_up));
+        let down = t1.mul(F32x8::splat(ctx.far_down));
         let entered = t0.le(up).or(t0.le(down)).and(t0.le(F32x8::splat(t_max)));
         (entered, t0)
     }

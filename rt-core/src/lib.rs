@@ -71,7 +71,7 @@ pub use glam;
 #[doc(hidden)]
 pub mod internal {
     pub use crate::{
-        aabb::{SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG, widen_far},
+        aabb::{FAR_INV_SCALE, SLAB_FAR_SCALE, SLAB_FAR_SCALE_NEG, widen_far},
         intersect::triangle::{settle_triangle_t, triangle_admits_hit},
     };
 }
