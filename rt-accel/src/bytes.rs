@@ -103,7 +103,8 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         let items: &[P] =
             bytemuck::try_cast_slice(&bytes[ir]).map_err(|_| LoadError::Misaligned)?;
         validate(nodes, items, h.prim_count)?;
-        Ok(Self { nodes, items, prim_count: h.prim_count, isa: crate::Isa::detect() })
+        let fused = crate::traverse::fits_fused(nodes);
+        Ok(Self { nodes, items, prim_count: h.prim_count, isa: crate::Isa::detect(), fused })
     }
 
     /// Wraps arrays after checking them with [`validate`].
@@ -116,7 +117,8 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         prim_count: u32,
     ) -> Result<Self, LoadError> {
         validate(nodes, items, prim_count)?;
-        Ok(Self { nodes, items, prim_count, isa: crate::Isa::detect() })
+        let fused = crate::traverse::fits_fused(nodes);
+        Ok(Self { nodes, items, prim_count, isa: crate::Isa::detect(), fused })
     }
 }
 

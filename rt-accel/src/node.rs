@@ -130,6 +130,18 @@ impl Node {
         }
     }
 
+    /// Whether every non-empty child box lies within `±range` (false for a
+    /// NaN or infinite bound).
+    #[must_use]
+    pub(crate) fn within(&self, range: f32) -> bool {
+        (0..WIDTH).all(|i| {
+            let b = self.child_bounds(i);
+            self.children[i].is_empty()
+                || (b.min.abs().cmple(Vec3::splat(range)) & b.max.abs().cmple(Vec3::splat(range)))
+                    .all()
+        })
+    }
+
     /// The union of the child boxes.
     #[must_use]
     pub fn bounds(&self) -> Aabb {

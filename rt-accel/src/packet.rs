@@ -345,25 +345,25 @@ impl<P: Primitive> BvhRef<'_, P> {
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2")]
+    #[target_feature(enable = "avx,avx2,fma")]
     fn closest_packet_avx2(&self, rays: &[Ray; PACKET]) -> [BestHit; PACKET] {
         self.closest_packet_kernel::<true>(rays)
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
+    #[target_feature(enable = "avx,avx2,fma,avx512f,avx512vl")]
     fn closest_packet_avx512(&self, rays: &[Ray; PACKET]) -> [BestHit; PACKET] {
         self.closest_packet_kernel::<true>(rays)
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2")]
+    #[target_feature(enable = "avx,avx2,fma")]
     fn occluded_packet_avx2(&self, rays: &[Ray; PACKET]) -> u32 {
         self.occluded_packet_kernel::<true>(rays)
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
+    #[target_feature(enable = "avx,avx2,fma,avx512f,avx512vl")]
     fn occluded_packet_avx512(&self, rays: &[Ray; PACKET]) -> u32 {
         self.occluded_packet_kernel::<true>(rays)
     }

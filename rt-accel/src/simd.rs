@@ -204,6 +204,11 @@ mod avx {
         pub(crate) unsafe fn le(self, o: Self) -> Self {
             Self(unsafe { _mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0) })
         }
+        /// `self·a + b` with one rounding (the CPU must also have FMA).
+        #[inline(always)]
+        pub(crate) unsafe fn mul_add(self, a: Self, b: Self) -> Self {
+            Self(unsafe { _mm256_fmadd_ps(self.0, a.0, b.0) })
+        }
         /// Bitwise or.
         #[inline(always)]
         pub(crate) unsafe fn or(self, o: Self) -> Self {

@@ -78,13 +78,13 @@ impl<P: Primitive> BvhRef<'_, P> {
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2")]
+    #[target_feature(enable = "avx,avx2,fma")]
     fn closest_stream_avx2(&self, rays: &[Ray], out: &mut dyn FnMut(usize, Option<BestHit>)) {
         self.closest_stream::<true>(rays, out);
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
+    #[target_feature(enable = "avx,avx2,fma,avx512f,avx512vl")]
     fn closest_stream_avx512(&self, rays: &[Ray], out: &mut dyn FnMut(usize, Option<BestHit>)) {
         self.closest_stream::<true>(rays, out);
     }
@@ -138,13 +138,13 @@ impl<P: Primitive> BvhRef<'_, P> {
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2")]
+    #[target_feature(enable = "avx,avx2,fma")]
     fn occluded_stream_avx2(&self, rays: &[Ray], out: &mut dyn FnMut(usize, bool)) {
         self.occluded_stream_kernel::<true>(rays, out);
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
+    #[target_feature(enable = "avx,avx2,fma,avx512f,avx512vl")]
     fn occluded_stream_avx512(&self, rays: &[Ray], out: &mut dyn FnMut(usize, bool)) {
         self.occluded_stream_kernel::<true>(rays, out);
     }
@@ -165,15 +165,16 @@ impl<P: Primitive> BvhRef<'_, P> {
         let mut index = [0usize; GROUP];
         let mut stack = GroupStack::new();
         let mut n = 0;
-        // Whether every ray of the group has `t_min ≥ 0` (shadow and AO
-        // rays do): then the whole group takes the shorter box test.
+        // Whether the short box test applies to every ray of the group
+        // (shadow and AO rays: `t_min ≥ 0`, and on the AVX kernels, rays
+        // the fused test covers): then the whole group takes it.
         let mut nonneg = true;
         for (i, ray) in rays.iter().enumerate() {
             let Some(ctx) = RayCtx::new(ray) else {
                 out(i, false);
                 continue;
             };
-            nonneg &= ctx.ray.t_min >= 0.0;
+            nonneg &= self.short_test::<AVX>(&ctx);
             ctxs[n] = ctx;
             index[n] = i;
             n += 1;
@@ -191,7 +192,7 @@ impl<P: Primitive> BvhRef<'_, P> {
     }
 
     /// [`Self::occluded_group`] with the box test `nonneg` picks (true
-    /// only if every ray has `t_min ≥ 0`, see `box_test`).
+    /// only if the short test applies to every ray, see `short_test`).
     #[inline(always)]
     fn occluded_group_any<const AVX: bool>(
         &self,
@@ -261,9 +262,8 @@ impl<P: Primitive> BvhRef<'_, P> {
 /// `node`, each ray tested with the single-ray occlusion test. The AVX
 /// kernels gather the rays' bits with two vector operations per ray; the
 /// 4-wide one bit by bit. Branch-free: which children a ray enters is
-/// unpredictable. `NONNEG`: every ray of the group has `t_min ≥ 0`, so
-/// the shorter box test applies to each (`box_test`): shadow and AO
-/// streams +2–5 %.
+/// unpredictable. `NONNEG`: the short box test applies to every ray of
+/// the group (`short_test`): shadow and AO streams +2–5 %.
 #[inline(always)]
 fn group_box_test<const AVX: bool, const NONNEG: bool>(
     node: &Node,

@@ -30,6 +30,15 @@ pub struct BvhRef<'a, P: Primitive> {
     pub(crate) prim_count: u32,
     /// Always one [`Isa::is_available`] approved: the dispatch relies on it.
     pub(crate) isa: Isa,
+    /// Whether every box lies within the fused node test's range
+    /// ([`fits_fused`]): the AVX kernels use it for the rays it covers.
+    pub(crate) fused: bool,
+}
+
+/// Whether every node's boxes lie within the range the fused node test
+/// covers (`±2¹²⁶`, see `crate::ray_ctx::Fused`).
+pub(crate) fn fits_fused(nodes: &[Node]) -> bool {
+    nodes.iter().all(|n| n.within(crate::ray_ctx::FUSED_RANGE))
 }
 
 impl<P: Primitive> Clone for BvhRef<'_, P> {
@@ -183,13 +192,13 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2")]
+    #[target_feature(enable = "avx,avx2,fma")]
     fn occluded_avx2(&self, ray: &Ray, stack: &mut TraversalStack) -> bool {
         self.occluded_kernel::<true>(ray, stack)
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
+    #[target_feature(enable = "avx,avx2,fma,avx512f,avx512vl")]
     fn occluded_avx512(&self, ray: &Ray, stack: &mut TraversalStack) -> bool {
         self.occluded_kernel::<true>(ray, stack)
     }
@@ -209,11 +218,20 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         };
         let ctx = &ctx;
         let root = ChildRef::inner(0);
-        if ctx.ray.t_min >= 0.0 {
+        if self.short_test::<AVX>(ctx) {
             self.occluded_from::<AVX, true>(ctx, root, stack)
         } else {
             self.occluded_from::<AVX, false>(ctx, root, stack)
         }
+    }
+
+    /// Whether kernel `AVX`'s short node test (`NONNEG` in [`box_test`])
+    /// applies to the ray: on the AVX kernels, the fused test for the rays
+    /// and trees it covers (`crate::ray_ctx::Fused`); on the 4-wide ones,
+    /// the robust test for rays with `t_min ≥ 0`.
+    #[inline(always)]
+    pub(crate) fn short_test<const AVX: bool>(&self, ctx: &RayCtx) -> bool {
+        if AVX { self.fused && ctx.fused } else { ctx.ray.t_min >= 0.0 }
     }
 
     /// [`Self::occluded_kernel`] over the subtree `start` only.
@@ -312,13 +330,13 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2")]
+    #[target_feature(enable = "avx,avx2,fma")]
     fn closest_avx2(&self, ray: &Ray, stack: &mut TraversalStack) -> Option<BestHit> {
         self.closest_kernel::<true>(ray, &mut TraversalStats::default(), stack)
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
+    #[target_feature(enable = "avx,avx2,fma,avx512f,avx512vl")]
     fn closest_avx512(&self, ray: &Ray, stack: &mut TraversalStack) -> Option<BestHit> {
         self.closest_kernel::<true>(ray, &mut TraversalStats::default(), stack)
     }
@@ -341,7 +359,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             return Some(best);
         }
         let root = ChildRef::inner(0);
-        Some(if ctx.ray.t_min >= 0.0 {
+        Some(if self.short_test::<AVX>(ctx) {
             self.closest_from::<AVX, true>(ctx, root, best, stats, stack)
         } else {
             self.closest_from::<AVX, false>(ctx, root, best, stats, stack)
@@ -572,11 +590,14 @@ unsafe fn push_hit_children(out: *mut MaybeUninit<ChildRef>, node: &Node, mask: 
 /// ray's `far_up` and `far_down` (both 1 for the first kind, so the
 /// general form is right for every ray).
 ///
-/// `NONNEG`: the caller knows the ray has `t_min ≥ 0` (the single-ray
-/// kernels pick it per ray), and the mask is one compare, `t0 ≤ min(t1x,
-/// t1y, t1z, t_max)`, instead of two multiplies, three compares and two
-/// logical operations. The shorter form measured +2–5 % on every
-/// single-ray row (interleaved probe runs, best of 4).
+/// `NONNEG`: the short test applies to the ray (the kernels pick it per
+/// ray, [`BvhRef::short_test`]). On the 4-wide kernels the ray has `t_min
+/// ≥ 0`, and the mask is one compare, `t0 ≤ min(t1x, t1y, t1z, t_max)`,
+/// instead of two multiplies, three compares and two logical operations
+/// (+2–5 % on every single-ray row). On the AVX kernels it is the fused
+/// test ([`box_lanes_fused`]): one multiply-add per plane, admitting every
+/// box the robust test admits (and a sliver more), so the hits are the
+/// same.
 #[inline(always)]
 pub(crate) fn box_test<const AVX: bool, const NONNEG: bool>(
     node: &Node,
@@ -653,6 +674,50 @@ unsafe fn box_test_avx<const NONNEG: bool>(
     }
 }
 
+/// The fused node test: per plane one multiply-add with the ray's
+/// [`crate::ray_ctx::Fused`] constants, where the robust test takes a
+/// subtraction and a multiply on the dependent chain. It admits every box
+/// the robust test admits (the proof is at `Fused`), so the hits are the
+/// same, bit for bit; no distance is NaN, so the minima and maxima pair up
+/// as a tree (two levels, not three).
+///
+/// # Safety
+/// The CPU must have AVX and FMA; the ray must be one the test covers
+/// (`ctx.fused`) and the node's boxes within its range ([`fits_fused`]).
+/// Always inlined, into the kernels compiled with them.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) unsafe fn box_lanes_fused(
+    b: &[[[f32; 4]; 2]; 6],
+    ctx: &RayCtx,
+    t_max: f32,
+) -> (crate::simd::F32x8, crate::simd::F32x8) {
+    use crate::simd::{F32x8, Lanes as _};
+    debug_assert!(ctx.fused);
+    #[inline(always)]
+    unsafe fn slab(b: &[[[f32; 4]; 2]; 6], ctx: &RayCtx, a: usize) -> (F32x8, F32x8) {
+        // SAFETY: the caller guarantees AVX and FMA.
+        unsafe {
+            let f = &ctx.fz;
+            let (near, far) = ctx.planes(b, a);
+            let near = F32x8::from_groups(*near)
+                .mul_add(F32x8::splat(f.inv_near[a]), F32x8::splat(f.off_near[a]));
+            let far = F32x8::from_groups(*far)
+                .mul_add(F32x8::splat(f.inv_far[a]), F32x8::splat(f.off_far[a]));
+            (near, far)
+        }
+    }
+    // SAFETY: the caller guarantees AVX and FMA.
+    unsafe {
+        let (nx, fx) = slab(b, ctx, 0);
+        let (ny, fy) = slab(b, ctx, 1);
+        let (nz, fz) = slab(b, ctx, 2);
+        let t0 = nx.max(ny).max(nz.max(F32x8::splat(ctx.ray.t_min)));
+        let t1 = fx.min(fy).min(fz.min(F32x8::splat(t_max)));
+        (t0.le(t1), t0)
+    }
+}
+
 /// [`box_test_avx`] as lanes: all ones in the lanes of the boxes entered,
 /// and the entry distances.
 ///
@@ -685,14 +750,13 @@ pub(crate) unsafe fn box_lanes_avx<const NONNEG: bool>(
     }
     // SAFETY: the caller guarantees AVX.
     unsafe {
+        if NONNEG {
+            return box_lanes_fused(b, ctx, t_max);
+        }
         let (nx, fx) = slab(b, ctx, 0);
         let (ny, fy) = slab(b, ctx, 1);
         let (nz, fz) = slab(b, ctx, 2);
         let t0 = nx.max(ny.max(nz.max(F32x8::splat(ctx.ray.t_min))));
-        if NONNEG {
-            // The far distances are widened already (`FAR_INV_SCALE`).
-            return (t0.le(fx.min(fy.min(fz.min(F32x8::splat(t_max))))), t0);
-        }
         let t1 = fx.min(fy.min(fz.min(F32x8::splat(f32::INFINITY))));
         // `t0 ≤ min(max(t1·up, t1·down), t_max)` as three compares side by
         // side (none of the values is NaN: the same mask, a shorter chain).
