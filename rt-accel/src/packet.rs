@@ -27,6 +27,7 @@ use crate::{
     Isa, RayCtx,
     node::{ChildRef, GROUPS, Node, WIDTH},
     prim::{BestHit, Primitive, any_leaf, closest_leaf},
+    ray_ctx::Fused,
     traverse::{BvhRef, STACK_SIZE, TraversalStack, TraversalStats},
 };
 
@@ -393,8 +394,9 @@ impl<P: Primitive> BvhRef<'_, P> {
                     bits &= bits - 1;
                     if let Some(ctx) = &l.ctx[r] {
                         let mut stats = TraversalStats::default();
-                        best[r] = self.closest_from::<AVX, false>(
+                        best[r] = self.closest_from::<AVX, false, false>(
                             ctx,
+                            &Fused::OFF,
                             cur,
                             best[r],
                             &mut stats,
@@ -470,7 +472,12 @@ impl<P: Primitive> BvhRef<'_, P> {
                     let r = bits.trailing_zeros() as usize;
                     bits &= bits - 1;
                     if let Some(ctx) = &l.ctx[r]
-                        && self.occluded_from::<AVX, false>(ctx, cur, &mut single)
+                        && self.occluded_from::<AVX, false, false>(
+                            ctx,
+                            &Fused::OFF,
+                            cur,
+                            &mut single,
+                        )
                     {
                         done |= 1 << r;
                     }

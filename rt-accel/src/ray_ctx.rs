@@ -38,11 +38,6 @@ pub struct RayCtx {
     pub(crate) wt: WatertightRay,
     /// Origin permuted to `[kx, ky, kz]`.
     pub(crate) wt_org: glam::Vec3,
-    /// The fused node test's constants ([`Fused`]; meaningful only where
-    /// `fused` is set).
-    pub(crate) fz: Fused,
-    /// Whether the fused node test covers this ray (see [`Fused`]).
-    pub(crate) fused: bool,
 }
 
 /// The constants of the fused node test (one multiply-add per plane, see
@@ -93,7 +88,7 @@ pub struct RayCtx {
 /// The bounds need every value above to be finite and the reciprocals
 /// normal, and `b − o` not to overflow: the ray has `t_min ≥ 0`, `|o| ≤
 /// 2¹²⁶`, `2⁻¹²⁵ ≤ |inv| ≤ 2¹²⁶` per axis and finite offsets (else
-/// `RayCtx::fused` is false), and the BVH's boxes lie within `±2¹²⁶`
+/// `Fused::on` is false), and the BVH's boxes lie within `±2¹²⁶`
 /// (empty slots' infinite bounds give `±∞` distances, never NaN, and are
 /// never entered). Rays along an axis (`d = ±0`, `inv = ±∞`) take the
 /// robust test. The test
@@ -101,10 +96,13 @@ pub struct RayCtx {
 /// this over every scale.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Fused {
-    pub(crate) inv_near: glam::Vec3,
-    pub(crate) off_near: glam::Vec3,
-    pub(crate) inv_far: glam::Vec3,
-    pub(crate) off_far: glam::Vec3,
+    /// Whether the test covers the ray and its BVH (else the robust test
+    /// runs, and the other fields are not used).
+    pub(crate) on: bool,
+    pub(crate) inv_near: glam::Vec3A,
+    pub(crate) off_near: glam::Vec3A,
+    pub(crate) inv_far: glam::Vec3A,
+    pub(crate) off_far: glam::Vec3A,
 }
 
 /// The largest coordinate (of a ray origin or a box) the fused node test
@@ -112,16 +110,30 @@ pub(crate) struct Fused {
 pub(crate) const FUSED_RANGE: f32 = (1u128 << 126) as f32;
 
 impl Fused {
-    /// The constants for a ray with origin `o`, reciprocal direction `inv`
-    /// and far reciprocal `inv_f` (`t_min ≥ 0`), and whether they lie in
-    /// the ranges the bounds above need.
+    /// For kernels that do not use the test (packets, streams): their
+    /// per-ray constants stay small, and the branch on `on` folds away.
+    pub(crate) const OFF: Self = Self {
+        on: false,
+        inv_near: glam::Vec3A::ZERO,
+        off_near: glam::Vec3A::ZERO,
+        inv_far: glam::Vec3A::ZERO,
+        off_far: glam::Vec3A::ZERO,
+    };
+
+    /// The constants for the ray of `ctx`, on where the test covers it
+    /// and `tree_in_range` (the BVH's boxes lie in its range,
+    /// [`crate::traverse::fits_fused`]).
     #[inline(always)]
-    fn new(o: glam::Vec3, inv: glam::Vec3, inv_f: glam::Vec3) -> (Self, bool) {
+    pub(crate) fn new(ctx: &RayCtx, tree_in_range: bool) -> Self {
         use glam::Vec3A;
+        if !tree_in_range || ctx.ray.t_min < 0.0 {
+            return Self::OFF;
+        }
+        let (o, inv, inv_f) =
+            (Vec3A::from(ctx.ray.origin), Vec3A::from(ctx.inv1), Vec3A::from(ctx.inv_far));
         const EIGHT_U: f32 = 8.0 * (f32::EPSILON * 0.5);
         // 2⁻¹²⁰: offsets smaller than this move out to twice it.
         const TINY: f32 = 1.0 / (1u128 << 120) as f32;
-        let (o, inv, inv_f) = (Vec3A::from(o), Vec3A::from(inv), Vec3A::from(inv_f));
         let inv_near = inv * (1.0 - EIGHT_U);
         let inv_far = inv_f * (1.0 + EIGHT_U);
         let (p, q) = (o * inv_near, o * inv_far);
@@ -136,13 +148,7 @@ impl Fused {
             & a.cmple(Vec3A::splat(FUSED_RANGE))
             & off_near.is_finite_mask()
             & off_far.is_finite_mask();
-        let fused = Self {
-            inv_near: inv_near.into(),
-            off_near: off_near.into(),
-            inv_far: inv_far.into(),
-            off_far: off_far.into(),
-        };
-        (fused, ok.all())
+        Self { on: ok.all(), inv_near, off_near, inv_far, off_far }
     }
 }
 
@@ -170,7 +176,6 @@ impl RayCtx {
         let [kx, ky, kz] = wt.axes;
         let inv = d.recip();
         let inv_far = if nonneg { inv * FAR_INV_SCALE } else { inv };
-        let (fused_consts, fused) = Fused::new(o, inv, inv_far);
         Some(Self {
             ray: *ray,
             inv1: inv,
@@ -181,8 +186,6 @@ impl RayCtx {
             far: [fx, fy, fz],
             wt,
             wt_org: glam::Vec3::new(o[kx], o[ky], o[kz]),
-            fz: fused_consts,
-            fused: nonneg && fused,
         })
     }
 
@@ -253,7 +256,7 @@ mod tests {
     use glam::Vec3;
     use rt_core::{Aabb, Ray};
 
-    use super::RayCtx;
+    use super::{Fused, RayCtx};
     use crate::{
         Isa,
         node::{Node, WIDTH},
@@ -262,13 +265,13 @@ mod tests {
 
     /// The fused test of one box, in scalars (`f32::mul_add` rounds once,
     /// as the kernel's multiply-add does): `(admitted, entry distance)`.
-    fn fused_scalar(ctx: &RayCtx, b: &Aabb, t_max: f32) -> (bool, f32) {
+    fn fused_scalar(ctx: &RayCtx, fz: &Fused, b: &Aabb, t_max: f32) -> (bool, f32) {
         let (mut t0, mut t1) = (ctx.ray.t_min, t_max);
         for a in 0..3 {
             let neg = ctx.ray.direction[a].is_sign_negative();
             let (n, f) = if neg { (b.max[a], b.min[a]) } else { (b.min[a], b.max[a]) };
-            t0 = t0.max(n.mul_add(ctx.fz.inv_near[a], ctx.fz.off_near[a]));
-            t1 = t1.min(f.mul_add(ctx.fz.inv_far[a], ctx.fz.off_far[a]));
+            t0 = t0.max(n.mul_add(fz.inv_near[a], fz.off_near[a]));
+            t1 = t1.min(f.mul_add(fz.inv_far[a], fz.off_far[a]));
         }
         (t0 <= t1, t0)
     }
@@ -359,14 +362,16 @@ mod tests {
             let t_min = if g.next().is_multiple_of(4) { 0.0 } else { g.unit() * scale };
             let t_max = if g.next().is_multiple_of(2) { f32::INFINITY } else { g.unit() * 4.0 };
             let Some(ctx) = RayCtx::new(&Ray::with_range(o, d, t_min, t_max)) else { continue };
-            if !ctx.fused || !node.within(super::FUSED_RANGE) {
+            let fz = Fused::new(&ctx, node.within(super::FUSED_RANGE));
+            if !fz.on {
                 continue;
             }
             covered += 1;
-            let (robust, robust_t0) = box_test::<false, true>(&node, &ctx, t_max);
+            let (robust, robust_t0) =
+                box_test::<false, true, false>(&node, &ctx, &Fused::OFF, t_max);
             let mut fused = 0;
             for (slot, b) in boxes.iter().enumerate() {
-                let (admit, t0) = fused_scalar(&ctx, b, t_max);
+                let (admit, t0) = fused_scalar(&ctx, &fz, b, t_max);
                 fused |= u32::from(admit) << slot;
                 if robust >> slot & 1 != 0 {
                     robust_in += 1;
@@ -392,7 +397,7 @@ mod tests {
                 // SAFETY: the CPU has AVX2 and FMA (checked above); the ray
                 // and the node are covered.
                 let (lanes, _) =
-                    unsafe { crate::traverse::box_lanes_fused(&node.bounds, &ctx, t_max) };
+                    unsafe { crate::traverse::box_lanes_fused(&node.bounds, &ctx, &fz, t_max) };
                 // SAFETY: as above.
                 assert_eq!(unsafe { lanes.sign_mask() }, fused, "{:?}", ctx.ray);
             }

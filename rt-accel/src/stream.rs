@@ -22,6 +22,7 @@ use crate::{
     Isa, RayCtx,
     node::{ChildRef, Node, WIDTH},
     prim::{BestHit, Primitive, any_leaf},
+    ray_ctx::Fused,
     traverse::{BvhRef, STACK_SIZE, TraversalStack, TraversalStats, Walk, box_test},
 };
 
@@ -106,7 +107,13 @@ impl<P: Primitive> BvhRef<'_, P> {
             for (lane, stack) in lanes.iter_mut().zip(&mut stacks) {
                 let Some(l) = lane else { continue };
                 live = true;
-                if !self.closest_step::<AVX, false>(&l.ctx, &mut l.walk, &mut stats, stack) {
+                if !self.closest_step::<AVX, false, false>(
+                    &l.ctx,
+                    &Fused::OFF,
+                    &mut l.walk,
+                    &mut stats,
+                    stack,
+                ) {
                     let best = l.walk.best;
                     out(l.index, best.is_hit().then_some(best));
                     *lane = next_lane(rays, &mut next, |i| out(i, None));
@@ -165,16 +172,15 @@ impl<P: Primitive> BvhRef<'_, P> {
         let mut index = [0usize; GROUP];
         let mut stack = GroupStack::new();
         let mut n = 0;
-        // Whether the short box test applies to every ray of the group
-        // (shadow and AO rays: `t_min ≥ 0`, and on the AVX kernels, rays
-        // the fused test covers): then the whole group takes it.
+        // Whether every ray of the group has `t_min ≥ 0` (shadow and AO
+        // rays do): then the whole group takes the shorter box test.
         let mut nonneg = true;
         for (i, ray) in rays.iter().enumerate() {
             let Some(ctx) = RayCtx::new(ray) else {
                 out(i, false);
                 continue;
             };
-            nonneg &= self.short_test::<AVX>(&ctx);
+            nonneg &= ctx.ray.t_min >= 0.0;
             ctxs[n] = ctx;
             index[n] = i;
             n += 1;
@@ -192,7 +198,7 @@ impl<P: Primitive> BvhRef<'_, P> {
     }
 
     /// [`Self::occluded_group`] with the box test `nonneg` picks (true
-    /// only if the short test applies to every ray, see `short_test`).
+    /// only if every ray has `t_min ≥ 0`, see `box_test`).
     #[inline(always)]
     fn occluded_group_any<const AVX: bool>(
         &self,
@@ -262,8 +268,9 @@ impl<P: Primitive> BvhRef<'_, P> {
 /// `node`, each ray tested with the single-ray occlusion test. The AVX
 /// kernels gather the rays' bits with two vector operations per ray; the
 /// 4-wide one bit by bit. Branch-free: which children a ray enters is
-/// unpredictable. `NONNEG`: the short box test applies to every ray of
-/// the group (`short_test`): shadow and AO streams +2–5 %.
+/// unpredictable. `NONNEG`: every ray of the group has `t_min ≥ 0`, so
+/// the shorter box test applies to each (`box_test`): shadow and AO
+/// streams +2–5 %.
 #[inline(always)]
 fn group_box_test<const AVX: bool, const NONNEG: bool>(
     node: &Node,
@@ -283,7 +290,12 @@ fn group_box_test<const AVX: bool, const NONNEG: bool>(
                 m &= m - 1;
                 let ctx = &ctxs[r];
                 // Widened as in the single-ray occlusion test.
-                let (entered, _) = box_lanes_avx::<NONNEG>(node, ctx, widen_far(ctx.ray.t_max));
+                let (entered, _) = box_lanes_avx::<NONNEG, false>(
+                    node,
+                    ctx,
+                    &Fused::OFF,
+                    widen_far(ctx.ray.t_max),
+                );
                 acc = acc.or(entered.and(F32x8::splat_bits(1 << r)));
             }
             acc.to_bits()
@@ -296,7 +308,8 @@ fn group_box_test<const AVX: bool, const NONNEG: bool>(
         m &= m - 1;
         let ctx = &ctxs[r];
         // Widened as in the single-ray occlusion test.
-        let (hit, _) = box_test::<AVX, NONNEG>(node, ctx, widen_far(ctx.ray.t_max));
+        let (hit, _) =
+            box_test::<AVX, NONNEG, false>(node, ctx, &Fused::OFF, widen_far(ctx.ray.t_max));
         for (i, c) in child.iter_mut().enumerate() {
             *c |= (hit >> i & 1) << r;
         }

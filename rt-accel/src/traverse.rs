@@ -9,6 +9,7 @@ use crate::{
     Isa, RayCtx, UnsupportedIsa,
     node::{ChildRef, GROUPS, Node, WIDTH},
     prim::{BestHit, Primitive, any_leaf, closest_leaf},
+    ray_ctx::Fused,
     simd::prefetch_bytes,
 };
 
@@ -217,28 +218,23 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             return false;
         };
         let ctx = &ctx;
+        let fz = &if AVX { Fused::new(ctx, self.fused) } else { Fused::OFF };
         let root = ChildRef::inner(0);
-        if self.short_test::<AVX>(ctx) {
-            self.occluded_from::<AVX, true>(ctx, root, stack)
+        if ctx.ray.t_min < 0.0 {
+            self.occluded_from::<AVX, false, false>(ctx, fz, root, stack)
+        } else if AVX && fz.on {
+            self.occluded_from::<AVX, true, true>(ctx, fz, root, stack)
         } else {
-            self.occluded_from::<AVX, false>(ctx, root, stack)
+            self.occluded_from::<AVX, true, false>(ctx, fz, root, stack)
         }
-    }
-
-    /// Whether kernel `AVX`'s short node test (`NONNEG` in [`box_test`])
-    /// applies to the ray: on the AVX kernels, the fused test for the rays
-    /// and trees it covers (`crate::ray_ctx::Fused`); on the 4-wide ones,
-    /// the robust test for rays with `t_min ≥ 0`.
-    #[inline(always)]
-    pub(crate) fn short_test<const AVX: bool>(&self, ctx: &RayCtx) -> bool {
-        if AVX { self.fused && ctx.fused } else { ctx.ray.t_min >= 0.0 }
     }
 
     /// [`Self::occluded_kernel`] over the subtree `start` only.
     #[inline(always)]
-    pub(crate) fn occluded_from<const AVX: bool, const NONNEG: bool>(
+    pub(crate) fn occluded_from<const AVX: bool, const NONNEG: bool, const FUSED: bool>(
         &self,
         ctx: &RayCtx,
+        fz: &Fused,
         start: ChildRef,
         stack: &mut TraversalStack,
     ) -> bool {
@@ -258,7 +254,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 // distance just past `t_max` may hold a hit at exactly
                 // `t_max` (found by the `bvh` fuzz target with
                 // `t_min = t_max`).
-                let (mask, _) = box_test::<AVX, NONNEG>(node, ctx, widen_far(t_max));
+                let (mask, _) = box_test::<AVX, NONNEG, FUSED>(node, ctx, fz, widen_far(t_max));
                 // Empty slots are never entered (see `closest_step`). The
                 // hit children are pushed in slot order and the last one
                 // is visited next, taken from the node rather than
@@ -358,11 +354,14 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         if self.nodes.is_empty() {
             return Some(best);
         }
+        let fz = &if AVX { Fused::new(ctx, self.fused) } else { Fused::OFF };
         let root = ChildRef::inner(0);
-        Some(if self.short_test::<AVX>(ctx) {
-            self.closest_from::<AVX, true>(ctx, root, best, stats, stack)
+        Some(if ctx.ray.t_min < 0.0 {
+            self.closest_from::<AVX, false, false>(ctx, fz, root, best, stats, stack)
+        } else if AVX && fz.on {
+            self.closest_from::<AVX, true, true>(ctx, fz, root, best, stats, stack)
         } else {
-            self.closest_from::<AVX, false>(ctx, root, best, stats, stack)
+            self.closest_from::<AVX, true, false>(ctx, fz, root, best, stats, stack)
         })
     }
 
@@ -370,16 +369,17 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     /// on `best` (the packets hand a subtree to it once a single ray is
     /// left in it).
     #[inline(always)]
-    pub(crate) fn closest_from<const AVX: bool, const NONNEG: bool>(
+    pub(crate) fn closest_from<const AVX: bool, const NONNEG: bool, const FUSED: bool>(
         &self,
         ctx: &RayCtx,
+        fz: &Fused,
         start: ChildRef,
         best: BestHit,
         stats: &mut TraversalStats,
         stack: &mut TraversalStack,
     ) -> BestHit {
         let mut walk = Walk { cur: start, sp: 0, best };
-        while self.closest_step::<AVX, NONNEG>(ctx, &mut walk, stats, stack) {}
+        while self.closest_step::<AVX, NONNEG, FUSED>(ctx, fz, &mut walk, stats, stack) {}
         walk.best
     }
 
@@ -388,9 +388,10 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     /// entry distance, skipping stacked subtrees that start beyond the
     /// best hit. False when nothing is left to visit.
     #[inline(always)]
-    pub(crate) fn closest_step<const AVX: bool, const NONNEG: bool>(
+    pub(crate) fn closest_step<const AVX: bool, const NONNEG: bool, const FUSED: bool>(
         &self,
         ctx: &RayCtx,
+        fz: &Fused,
         walk: &mut Walk,
         stats: &mut TraversalStats,
         stack: &mut TraversalStack,
@@ -408,7 +409,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             // may still hold an exact tie; widen the bound as the far
             // planes are widened.
             let bound = widen_far(best.t);
-            let (mask, tnear) = box_test::<AVX, NONNEG>(node, ctx, bound);
+            let (mask, tnear) = box_test::<AVX, NONNEG, FUSED>(node, ctx, fz, bound);
             // Empty slots hold the empty box, which no ray enters
             // (`validate` rejects blobs where they do not): `mask` names
             // real children only. One or two children (most nodes) take
@@ -590,18 +591,21 @@ unsafe fn push_hit_children(out: *mut MaybeUninit<ChildRef>, node: &Node, mask: 
 /// ray's `far_up` and `far_down` (both 1 for the first kind, so the
 /// general form is right for every ray).
 ///
-/// `NONNEG`: the short test applies to the ray (the kernels pick it per
-/// ray, [`BvhRef::short_test`]). On the 4-wide kernels the ray has `t_min
-/// ≥ 0`, and the mask is one compare, `t0 ≤ min(t1x, t1y, t1z, t_max)`,
-/// instead of two multiplies, three compares and two logical operations
-/// (+2–5 % on every single-ray row). On the AVX kernels it is the fused
-/// test ([`box_lanes_fused`]): one multiply-add per plane, admitting every
-/// box the robust test admits (and a sliver more), so the hits are the
-/// same.
+/// `NONNEG`: the caller knows the ray has `t_min ≥ 0` (the kernels pick
+/// it per ray), and the mask is one compare, `t0 ≤ min(t1x, t1y, t1z,
+/// t_max)`, instead of two multiplies, three compares and two logical
+/// operations (+2–5 % on every single-ray row).
+///
+/// `FUSED` (AVX kernels only; `fz.on` must hold): the fused test
+/// ([`box_lanes_fused`]), one multiply-add per plane, admitting every box
+/// the robust test admits (and a sliver more), so the hits are the same.
+/// The single-ray kernels pick it per ray, at entry: chosen per node
+/// instead, by a branch on `fz.on`, the kernels ran 3–6 % slower.
 #[inline(always)]
-pub(crate) fn box_test<const AVX: bool, const NONNEG: bool>(
+pub(crate) fn box_test<const AVX: bool, const NONNEG: bool, const FUSED: bool>(
     node: &Node,
     ctx: &RayCtx,
+    fz: &Fused,
     t_max: f32,
 ) -> (u32, [f32; WIDTH]) {
     #[cfg(target_arch = "x86_64")]
@@ -609,8 +613,9 @@ pub(crate) fn box_test<const AVX: bool, const NONNEG: bool>(
         // SAFETY: `AVX` kernels are instantiated only inside the functions
         // compiled with AVX enabled (`closest_avx2`, …), which are called
         // only when `Isa::is_available` found the CPU has it.
-        return unsafe { box_test_avx::<NONNEG>(node, ctx, t_max) };
+        return unsafe { box_test_avx::<NONNEG, FUSED>(node, ctx, fz, t_max) };
     }
+    let _ = fz;
     box_test_x4::<NONNEG>(node, ctx, t_max)
 }
 
@@ -662,14 +667,15 @@ fn box_test_x4<const NONNEG: bool>(node: &Node, ctx: &RayCtx, t_max: f32) -> (u3
 /// The CPU must have AVX. Always inlined, into the kernels compiled with it.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn box_test_avx<const NONNEG: bool>(
+unsafe fn box_test_avx<const NONNEG: bool, const FUSED: bool>(
     node: &Node,
     ctx: &RayCtx,
+    fz: &Fused,
     t_max: f32,
 ) -> (u32, [f32; WIDTH]) {
     // SAFETY: the caller guarantees AVX.
     unsafe {
-        let (entered, t0) = box_lanes_avx::<NONNEG>(node, ctx, t_max);
+        let (entered, t0) = box_lanes_avx::<NONNEG, FUSED>(node, ctx, fz, t_max);
         (entered.sign_mask(), t0.to_array())
     }
 }
@@ -682,23 +688,23 @@ unsafe fn box_test_avx<const NONNEG: bool>(
 /// as a tree (two levels, not three).
 ///
 /// # Safety
-/// The CPU must have AVX and FMA; the ray must be one the test covers
-/// (`ctx.fused`) and the node's boxes within its range ([`fits_fused`]).
+/// The CPU must have AVX and FMA; `f` must be on (the test covers the ray
+/// and the BVH).
 /// Always inlined, into the kernels compiled with them.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) unsafe fn box_lanes_fused(
     b: &[[[f32; 4]; 2]; 6],
     ctx: &RayCtx,
+    f: &Fused,
     t_max: f32,
 ) -> (crate::simd::F32x8, crate::simd::F32x8) {
     use crate::simd::{F32x8, Lanes as _};
-    debug_assert!(ctx.fused);
+    debug_assert!(f.on);
     #[inline(always)]
-    unsafe fn slab(b: &[[[f32; 4]; 2]; 6], ctx: &RayCtx, a: usize) -> (F32x8, F32x8) {
+    unsafe fn slab(b: &[[[f32; 4]; 2]; 6], ctx: &RayCtx, f: &Fused, a: usize) -> (F32x8, F32x8) {
         // SAFETY: the caller guarantees AVX and FMA.
         unsafe {
-            let f = &ctx.fz;
             let (near, far) = ctx.planes(b, a);
             let near = F32x8::from_groups(*near)
                 .mul_add(F32x8::splat(f.inv_near[a]), F32x8::splat(f.off_near[a]));
@@ -709,9 +715,9 @@ pub(crate) unsafe fn box_lanes_fused(
     }
     // SAFETY: the caller guarantees AVX and FMA.
     unsafe {
-        let (nx, fx) = slab(b, ctx, 0);
-        let (ny, fy) = slab(b, ctx, 1);
-        let (nz, fz) = slab(b, ctx, 2);
+        let (nx, fx) = slab(b, ctx, f, 0);
+        let (ny, fy) = slab(b, ctx, f, 1);
+        let (nz, fz) = slab(b, ctx, f, 2);
         let t0 = nx.max(ny).max(nz.max(F32x8::splat(ctx.ray.t_min)));
         let t1 = fx.min(fy).min(fz.min(F32x8::splat(t_max)));
         (t0.le(t1), t0)
@@ -725,9 +731,10 @@ pub(crate) unsafe fn box_lanes_fused(
 /// The CPU must have AVX. Always inlined, into the kernels compiled with it.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-pub(crate) unsafe fn box_lanes_avx<const NONNEG: bool>(
+pub(crate) unsafe fn box_lanes_avx<const NONNEG: bool, const FUSED: bool>(
     node: &Node,
     ctx: &RayCtx,
+    fz: &Fused,
     t_max: f32,
 ) -> (crate::simd::F32x8, crate::simd::F32x8) {
     use crate::simd::{F32x8, Lanes as _};
@@ -750,13 +757,17 @@ pub(crate) unsafe fn box_lanes_avx<const NONNEG: bool>(
     }
     // SAFETY: the caller guarantees AVX.
     unsafe {
-        if NONNEG {
-            return box_lanes_fused(b, ctx, t_max);
+        if FUSED {
+            return box_lanes_fused(b, ctx, fz, t_max);
         }
         let (nx, fx) = slab(b, ctx, 0);
         let (ny, fy) = slab(b, ctx, 1);
         let (nz, fz) = slab(b, ctx, 2);
         let t0 = nx.max(ny.max(nz.max(F32x8::splat(ctx.ray.t_min))));
+        if NONNEG {
+            // The far distances are widened already (`FAR_INV_SCALE`).
+            return (t0.le(fx.min(fy.min(fz.min(F32x8::splat(t_max))))), t0);
+        }
         let t1 = fx.min(fy.min(fz.min(F32x8::splat(f32::INFINITY))));
         // `t0 ≤ min(max(t1·up, t1·down), t_max)` as three compares side by
         // side (none of the values is NaN: the same mask, a shorter chain).

@@ -77,6 +77,38 @@ proptest! {
         }
     }
 
+    /// The same at every scale, from geometry below `2⁻¹⁰⁰` through trees
+    /// past the AVX kernels' fused node test's range (`2¹²⁶`), which then
+    /// take the robust test; with rays from the triangles' vertices (on
+    /// the boxes' planes) and rays along an axis among them.
+    #[test]
+    fn triangles_match_brute_force_at_every_scale(
+        (pos, idx) in soup(),
+        rays in prop::collection::vec(ray(), 48),
+        exp in prop::sample::select(vec![-110i32, -60, -20, 0, 40, 100, 118, 122, 124]),
+    ) {
+        let s = 2f32.powi(exp);
+        let pos: Vec<Vec3> = pos.iter().map(|&p| p * s).collect();
+        let mut rays: Vec<Ray> = rays
+            .iter()
+            .map(|r| Ray::with_range(r.origin * s, r.direction, r.t_min.max(0.0) * s, r.t_max * s))
+            .collect();
+        for (i, v) in pos.iter().enumerate().take(16) {
+            let d = if i % 2 == 0 { Vec3::new(0.0, -1.0, 0.0) } else { Vec3::new(0.3, -1.0, 0.2) };
+            rays.push(Ray::new(*v, d));
+            rays.push(Ray::new(*v + Vec3::Y * s, d));
+        }
+        let bvh = build_triangles(&pos, &idx, &BuildParams::medium()).unwrap();
+        for isa in Isa::available() {
+            let view = bvh.as_ref().with_isa(isa).unwrap();
+            for r in &rays {
+                let want = brute_triangles(&pos, &idx, r);
+                prop_assert_eq!(view.closest_t(r).map(|b| (b.t, b.prim)), want, "{} {:?}", isa, r);
+                prop_assert_eq!(view.occluded(r), want.is_some(), "{} {:?}", isa, r);
+            }
+        }
+    }
+
     /// Packets of eight rays (some invalid, some sharing an origin) answer
     /// exactly as the single-ray queries, on every kernel.
     #[test]
