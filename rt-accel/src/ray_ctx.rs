@@ -18,10 +18,10 @@ use crate::simd::F32x4;
 pub struct RayCtx {
     pub(crate) ray: Ray,
     /// Reciprocal direction per axis (`±∞` for `±0`).
-    pub(crate) inv1: glam::Vec3,
+    pub(crate) inv1: glam::Vec3A,
     /// The far planes' reciprocal: `inv1 · FAR_INV_SCALE` for rays with
     /// `t_min ≥ 0` ([`rt_core::internal::FAR_INV_SCALE`]), else `inv1`.
-    pub(crate) inv_far: glam::Vec3,
+    pub(crate) inv_far: glam::Vec3A,
     /// The factors that widen the smallest far distance upward and
     /// downward (`max` of the two products, [`widen_far`]): the Ize
     /// scales for rays with `t_min < 0`, `1` for the others (whose far
@@ -120,17 +120,13 @@ impl Fused {
         off_far: glam::Vec3A::ZERO,
     };
 
-    /// The constants for the ray of `ctx`, on where the test covers it
-    /// and `tree_in_range` (the BVH's boxes lie in its range,
-    /// [`crate::traverse::fits_fused`]).
+    /// The constants for a ray with origin `o`, reciprocal `inv` and far
+    /// reciprocal `inv_f`; on if `enable` (the ray has `t_min ≥ 0` and its
+    /// BVH lies in the test's range) and the ray is in the ranges the
+    /// bounds above need. Branch-free.
     #[inline(always)]
-    pub(crate) fn new(ctx: &RayCtx, tree_in_range: bool) -> Self {
+    fn from_parts(o: glam::Vec3A, inv: glam::Vec3A, inv_f: glam::Vec3A, enable: bool) -> Self {
         use glam::Vec3A;
-        if !tree_in_range || ctx.ray.t_min < 0.0 {
-            return Self::OFF;
-        }
-        let (o, inv, inv_f) =
-            (Vec3A::from(ctx.ray.origin), Vec3A::from(ctx.inv1), Vec3A::from(ctx.inv_far));
         const EIGHT_U: f32 = 8.0 * (f32::EPSILON * 0.5);
         // 2⁻¹²⁰: offsets smaller than this move out to twice it.
         const TINY: f32 = 1.0 / (1u128 << 120) as f32;
@@ -148,7 +144,7 @@ impl Fused {
             & a.cmple(Vec3A::splat(FUSED_RANGE))
             & off_near.is_finite_mask()
             & off_far.is_finite_mask();
-        Self { on: ok.all(), inv_near, off_near, inv_far, off_far }
+        Self { on: enable & ok.all(), inv_near, off_near, inv_far, off_far }
     }
 }
 
@@ -159,6 +155,24 @@ impl RayCtx {
     #[inline(always)]
     #[must_use]
     pub fn new(ray: &Ray) -> Option<Self> {
+        Self::build::<false>(ray, false).map(|(ctx, _)| ctx)
+    }
+
+    /// [`RayCtx::new`] with the fused node test's constants too, on where
+    /// the test covers the ray and `tree_in_range` (the BVH's boxes lie in
+    /// its range, [`crate::traverse::fits_fused`]): for the single-ray AVX
+    /// kernels, which made here (not by a separate call) keep them in
+    /// registers. Kept beside the context, not in it: packets and streams,
+    /// which store a context per ray, ran 2–11 % slower with the larger
+    /// one.
+    #[inline(always)]
+    #[must_use]
+    pub(crate) fn new_fused(ray: &Ray, tree_in_range: bool) -> Option<(Self, Fused)> {
+        Self::build::<true>(ray, tree_in_range)
+    }
+
+    #[inline(always)]
+    fn build<const FUSED: bool>(ray: &Ray, tree_in_range: bool) -> Option<(Self, Fused)> {
         if !ray.is_valid() {
             return None;
         }
@@ -174,9 +188,14 @@ impl RayCtx {
         let wt = WatertightRay::new(ray);
         let nonneg = ray.t_min >= 0.0;
         let [kx, ky, kz] = wt.axes;
-        let inv = d.recip();
+        let inv = glam::Vec3A::from(d).recip();
         let inv_far = if nonneg { inv * FAR_INV_SCALE } else { inv };
-        Some(Self {
+        let fused = if FUSED {
+            Fused::from_parts(o.into(), inv, inv_far, nonneg && tree_in_range)
+        } else {
+            Fused::OFF
+        };
+        let ctx = Self {
             ray: *ray,
             inv1: inv,
             inv_far,
@@ -186,7 +205,8 @@ impl RayCtx {
             far: [fx, fy, fz],
             wt,
             wt_org: glam::Vec3::new(o[kx], o[ky], o[kz]),
-        })
+        };
+        Some((ctx, fused))
     }
 
     /// The origin per axis, splatted.
@@ -361,8 +381,10 @@ mod tests {
             }
             let t_min = if g.next().is_multiple_of(4) { 0.0 } else { g.unit() * scale };
             let t_max = if g.next().is_multiple_of(2) { f32::INFINITY } else { g.unit() * 4.0 };
-            let Some(ctx) = RayCtx::new(&Ray::with_range(o, d, t_min, t_max)) else { continue };
-            let fz = Fused::new(&ctx, node.within(super::FUSED_RANGE));
+            let ray = Ray::with_range(o, d, t_min, t_max);
+            let Some((ctx, fz)) = RayCtx::new_fused(&ray, node.within(super::FUSED_RANGE)) else {
+                continue;
+            };
             if !fz.on {
                 continue;
             }
