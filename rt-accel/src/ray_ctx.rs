@@ -110,8 +110,8 @@ pub(crate) struct Fused {
 pub(crate) const FUSED_RANGE: f32 = (1u128 << 126) as f32;
 
 impl Fused {
-    /// For kernels that do not use the test (packets, streams): their
-    /// per-ray constants stay small, and the branch on `on` folds away.
+    /// For kernels that do not use the test: packets, streams and the
+    /// 4-wide kernels.
     pub(crate) const OFF: Self = Self {
         on: false,
         inv_near: glam::Vec3A::ZERO,
