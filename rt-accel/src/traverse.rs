@@ -214,12 +214,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     /// empty: the root is read unchecked (`occluded_with` checks).
     #[inline(always)]
     fn occluded_kernel<const AVX: bool>(&self, ray: &Ray, stack: &mut TraversalStack) -> bool {
-        let made = if AVX {
-            RayCtx::new_fused(ray, self.fused)
-        } else {
-            RayCtx::new(ray).map(|c| (c, Fused::OFF))
-        };
-        let Some((ctx, fz)) = made else {
+        let Some((ctx, fz)) = self.ray_constants::<AVX>(ray) else {
             return false;
         };
         let (ctx, fz) = (&ctx, &fz);
@@ -233,6 +228,18 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             self.occluded_from::<AVX, true, false>(ctx, fz, root, stack)
         } else {
             self.occluded_from::<AVX, false, false>(ctx, fz, root, stack)
+        }
+    }
+
+    /// The ray's constants for kernel `AVX`: with the fused node test's
+    /// on the AVX kernels (on where it covers the ray and this BVH), off
+    /// on the 4-wide ones; `None` for an invalid ray.
+    #[inline(always)]
+    fn ray_constants<const AVX: bool>(&self, ray: &Ray) -> Option<(RayCtx, Fused)> {
+        if AVX {
+            RayCtx::new_fused(ray, self.fused)
+        } else {
+            RayCtx::new(ray).map(|c| (c, Fused::OFF))
         }
     }
 
@@ -356,11 +363,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         stats: &mut TraversalStats,
         stack: &mut TraversalStack,
     ) -> Option<BestHit> {
-        let (ctx, fz) = &if AVX {
-            RayCtx::new_fused(ray, self.fused)
-        } else {
-            RayCtx::new(ray).map(|c| (c, Fused::OFF))
-        }?;
+        let (ctx, fz) = &self.ray_constants::<AVX>(ray)?;
         let best = BestHit::new(ctx.ray.t_max);
         if self.nodes.is_empty() {
             return Some(best);
