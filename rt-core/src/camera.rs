@@ -12,7 +12,7 @@ use glam::{Vec2, Vec3};
 
 use crate::{
     Ray,
-    math::{sin_cos, sqrt, tan},
+    math::{sin_cos_quarter, sqrt, tan},
 };
 
 /// How the camera projects.
@@ -179,13 +179,16 @@ pub fn concentric_disk(u: Vec2) -> Vec2 {
     if o == Vec2::ZERO {
         return Vec2::ZERO;
     }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, core::f32::consts::FRAC_PI_4 * (o.y / o.x))
+    // The angle is `π/4·(o.y/o.x)`, or `π/2 − π/4·(o.x/o.y)`, whose sine
+    // and cosine are the cosine and sine of `π/4·(o.x/o.y)`: either way a
+    // sine and cosine within `±π/4`.
+    if o.x.abs() > o.y.abs() {
+        let (s, c) = sin_cos_quarter(core::f32::consts::FRAC_PI_4 * (o.y / o.x));
+        o.x * Vec2::new(c, s)
     } else {
-        (o.y, core::f32::consts::FRAC_PI_2 - core::f32::consts::FRAC_PI_4 * (o.x / o.y))
-    };
-    let (s, c) = sin_cos(theta);
-    r * Vec2::new(c, s)
+        let (s, c) = sin_cos_quarter(core::f32::consts::FRAC_PI_4 * (o.x / o.y));
+        o.y * Vec2::new(s, c)
+    }
 }
 
 /// Cosine-weighted direction about `+z` from `u ∈ [0, 1)²` (Malley's method).
