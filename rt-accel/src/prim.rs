@@ -122,8 +122,8 @@ pub trait Primitive: bytemuck::Pod + Sealed {
     /// Whether any primitive of the item is hit with `t ∈ [t_min, t_max]`.
     fn any(&self, ray: &RayCtx, t_max: f32) -> bool;
     /// The full hit record for `lane`, whose hit at parameter `t` was found
-    /// by [`Primitive::closest`] for `ray` (re-run with `t_max = t`, so the
-    /// same arithmetic finds the same hit).
+    /// by [`Primitive::closest`] for `ray`: the same `t`, and the rest as
+    /// the primitive's scalar test computes it.
     fn hit(&self, lane: u32, ray: &Ray, t: f32) -> Option<Hit>;
     /// The box around the item's primitives.
     fn bounds(&self) -> Aabb;

@@ -9,7 +9,7 @@ use rt_accel::{
 use rt_core::{
     Ray,
     glam::Vec3,
-    intersect::{Capsule, Sphere},
+    intersect::{Capsule, Sphere, intersect_triangle},
 };
 use support::*;
 
@@ -72,6 +72,13 @@ proptest! {
                 prop_assert_eq!(view.occluded(r), want.is_some(), "{}", isa);
                 if let Some(h) = view.closest_hit(r) {
                     prop_assert_eq!((h.t, h.prim), want.unwrap());
+                    // The whole record, as the scalar test makes it for
+                    // that triangle alone: same barycentrics, normal,
+                    // position and error bound, bit for bit.
+                    let [a, b, c] = idx[h.prim as usize].map(|k| pos[k as usize]);
+                    let mut s = intersect_triangle(r, a, b, c).unwrap();
+                    s.prim = h.prim;
+                    prop_assert_eq!(h, s, "{}", isa);
                 }
             }
         }

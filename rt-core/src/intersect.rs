@@ -14,5 +14,5 @@ pub use offset::{next_float_down, next_float_up, offset_ray_origin, spawn_ray, s
 pub use sphere::{Sphere, intersect_sphere, intersect_sphere_t, solve_quadratic};
 pub use triangle::{
     TriangleHit, WatertightRay, intersect_triangle, intersect_triangle_t, is_degenerate_triangle,
-    triangle_hit,
+    triangle_barycentrics, triangle_hit,
 };

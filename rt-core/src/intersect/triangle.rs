@@ -58,6 +58,60 @@ pub struct TriangleHit {
     pub b2: f32,
 }
 
+/// The watertight test's sheared vertices and edge functions: the part
+/// of the test that decides whether the ray passes through the triangle.
+struct Edges {
+    /// Scaled barycentric coordinates (2-D edge functions), decided in
+    /// f64 where one is zero in f32.
+    u: f32,
+    v: f32,
+    w: f32,
+    /// The vertices' sheared distances along the ray, `S_z·(vᵢ − o)_kz`.
+    z: [f32; 3],
+}
+
+impl Edges {
+    #[inline]
+    fn new(ray: &Ray, pre: &WatertightRay, v0: Vec3, v1: Vec3, v2: Vec3) -> Self {
+        let [kx, ky, kz] = pre.axes;
+        let s = pre.shear;
+        // Vertices relative to the origin, sheared so the ray runs along +z.
+        let a = v0 - ray.origin;
+        let b = v1 - ray.origin;
+        let c = v2 - ray.origin;
+        let (ax, ay) = (a[kx] - s.x * a[kz], a[ky] - s.y * a[kz]);
+        let (bx, by) = (b[kx] - s.x * b[kz], b[ky] - s.y * b[kz]);
+        let (cx, cy) = (c[kx] - s.x * c[kz], c[ky] - s.y * c[kz]);
+        // Scaled barycentric coordinates: 2-D edge functions.
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            // On an edge in f32: decide the sign exactly in f64.
+            let f =
+                |p: f32, q: f32, r: f32, t: f32| (p as f64 * q as f64 - r as f64 * t as f64) as f32;
+            u = f(cx, by, cy, bx);
+            v = f(ax, cy, ay, cx);
+            w = f(bx, ay, by, ax);
+        }
+        Self { u, v, w, z: [s.z * a[kz], s.z * b[kz], s.z * c[kz]] }
+    }
+
+    /// `det = u + v + w` if the ray passes through the triangle (the edge
+    /// functions do not differ in sign) and it is neither 0 nor overflowed
+    /// (vertices near `f32::MAX`, which would make `t` a meaningless ±0:
+    /// no hit, as in the packet test).
+    #[inline]
+    fn det(&self) -> Option<f32> {
+        let (u, v, w) = (self.u, self.v, self.w);
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        (det != 0.0 && det.is_finite()).then_some(det)
+    }
+}
+
 /// The watertight test with precomputed `pre`; `None` on a miss, for
 /// degenerate triangles (`det = 0`), outside `[ray.t_min, ray.t_max]`, and
 /// for hits outside the triangle's box by rounding
@@ -71,37 +125,11 @@ pub fn intersect_triangle_t(
     v1: Vec3,
     v2: Vec3,
 ) -> Option<TriangleHit> {
-    let [kx, ky, kz] = pre.axes;
-    let s = pre.shear;
-    // Vertices relative to the origin, sheared so the ray runs along +z.
-    let a = v0 - ray.origin;
-    let b = v1 - ray.origin;
-    let c = v2 - ray.origin;
-    let (ax, ay) = (a[kx] - s.x * a[kz], a[ky] - s.y * a[kz]);
-    let (bx, by) = (b[kx] - s.x * b[kz], b[ky] - s.y * b[kz]);
-    let (cx, cy) = (c[kx] - s.x * c[kz], c[ky] - s.y * c[kz]);
-    // Scaled barycentric coordinates: 2-D edge functions.
-    let mut u = cx * by - cy * bx;
-    let mut v = ax * cy - ay * cx;
-    let mut w = bx * ay - by * ax;
-    if u == 0.0 || v == 0.0 || w == 0.0 {
-        // On an edge in f32: decide the sign exactly in f64.
-        let f = |p: f32, q: f32, r: f32, t: f32| (p as f64 * q as f64 - r as f64 * t as f64) as f32;
-        u = f(cx, by, cy, bx);
-        v = f(ax, cy, ay, cx);
-        w = f(bx, ay, by, ax);
-    }
-    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-        return None;
-    }
-    let det = u + v + w;
-    // An overflowed `det` (vertices near `f32::MAX`) would make `t` a
-    // meaningless ±0: no hit, as in the packet test.
-    if det == 0.0 || !det.is_finite() {
-        return None;
-    }
+    let e = Edges::new(ray, pre, v0, v1, v2);
+    let det = e.det()?;
+    let (u, v, w, [za, zb, zc]) = (e.u, e.v, e.w, e.z);
     // Scaled hit distance, then the true one.
-    let tt = u * (s.z * a[kz]) + v * (s.z * b[kz]) + w * (s.z * c[kz]);
+    let tt = u * za + v * zb + w * zc;
     let inv = 1.0 / det;
     let t = tt * inv;
     // A `t` that overflowed to `+∞` (vertices near `f32::MAX`) is no hit,
@@ -113,10 +141,29 @@ pub fn intersect_triangle_t(
     // a triangle large next to `t` it cancels, and can round below the
     // near plane of the triangle's (flat) box. Within a generous bound on
     // that rounding, it is moved onto the plane instead of rejected.
-    let terms = (u * (s.z * a[kz])).abs() + (v * (s.z * b[kz])).abs() + (w * (s.z * c[kz])).abs();
+    let terms = (u * za).abs() + (v * zb).abs() + (w * zc).abs();
     let slack = 8.0 * gamma(3) * terms * inv.abs();
     let t = settle_triangle_t(ray, t, slack, v0, v1, v2)?;
     Some(TriangleHit { t, b1: v * inv, b2: w * inv })
+}
+
+/// The barycentrics `(b1, b2)` that [`intersect_triangle_t`] reports for
+/// a hit, without its distance: `None` where the ray does not pass
+/// through the triangle. For a hit whose distance is known already (a
+/// BVH's traversal found it), this makes the same record for less: it
+/// skips the distance, its range test and its settling on the box.
+#[inline]
+#[must_use]
+pub fn triangle_barycentrics(
+    ray: &Ray,
+    pre: &WatertightRay,
+    v0: Vec3,
+    v1: Vec3,
+    v2: Vec3,
+) -> Option<(f32, f32)> {
+    let e = Edges::new(ray, pre, v0, v1, v2);
+    let inv = 1.0 / e.det()?;
+    Some((e.v * inv, e.w * inv))
 }
 
 /// The hit distance a triangle test reports for a computed `t` whose
