@@ -1,6 +1,6 @@
 //! Axis-aligned boxes and the conservative slab test.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use crate::{Ray, math::gamma};
 
@@ -155,26 +155,33 @@ impl Aabb {
         if !ray.is_valid() {
             return None;
         }
-        let inv = ray.direction.recip();
+        // Three lanes at once and no branch on the direction's signs
+        // (secondary rays leave surfaces every way, so branches on them
+        // mispredict): the same operations, lane by lane, as one axis at a
+        // time, so the same answer bit for bit.
+        let (o, d) = (Vec3A::from(ray.origin), Vec3A::from(ray.direction));
+        let inv = d.recip();
         let nonneg = ray.t_min >= 0.0;
         let inv_far = if nonneg { inv * FAR_INV_SCALE } else { inv };
-        let mut t0 = ray.t_min;
-        let mut t1 = ray.t_max;
+        // The sign *bit* picks the planes: −0.0 counts as negative.
+        let neg = Vec3A::ONE.copysign(d).cmplt(Vec3A::ZERO);
+        let (min, max) = (Vec3A::from(self.min), Vec3A::from(self.max));
+        let near = (Vec3A::select(neg, max, min) - o) * inv;
+        let far = (Vec3A::select(neg, min, max) - o) * inv_far;
+        let far = if nonneg {
+            far
+        } else {
+            let (a, b) = (far * SLAB_FAR_SCALE, far * SLAB_FAR_SCALE_NEG);
+            Vec3A::select(a.cmpgt(b), a, b)
+        };
+        // `x > t0` is false for NaN, so NaN leaves the bound alone.
+        let (mut t0, mut t1) = (ray.t_min, ray.t_max);
         for a in 0..3 {
-            let (lo, hi) = if ray.direction[a].is_sign_negative() {
-                (self.max[a], self.min[a])
-            } else {
-                (self.min[a], self.max[a])
-            };
-            let near = (lo - ray.origin[a]) * inv[a];
-            let far = (hi - ray.origin[a]) * inv_far[a];
-            let far = if nonneg { far } else { widen_far(far) };
-            // `x > t0` is false for NaN, so NaN leaves the bound alone.
-            if near > t0 {
-                t0 = near;
+            if near[a] > t0 {
+                t0 = near[a];
             }
-            if far < t1 {
-                t1 = far;
+            if far[a] < t1 {
+                t1 = far[a];
             }
         }
         (t0 <= t1).then_some((t0, t1))
