@@ -150,6 +150,7 @@ impl Aabb {
     /// plane gives `0·∞ = NaN` for that plane; the comparisons below are
     /// written so a NaN distance never narrows the interval (the box is
     /// closed, so such a ray touches it).
+    #[inline]
     #[must_use]
     pub fn intersect_ray(&self, ray: &Ray) -> Option<(f32, f32)> {
         if !ray.is_valid() {
