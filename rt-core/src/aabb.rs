@@ -169,20 +169,15 @@ impl Aabb {
         let (min, max) = (Vec3A::from(self.min), Vec3A::from(self.max));
         let near = (Vec3A::select(neg, max, min) - o) * inv;
         let far = (Vec3A::select(neg, min, max) - o) * inv_far;
-        let far = if nonneg {
-            far
-        } else {
-            let (a, b) = (far * SLAB_FAR_SCALE, far * SLAB_FAR_SCALE_NEG);
-            Vec3A::select(a.cmpgt(b), a, b)
-        };
         // `x > t0` is false for NaN, so NaN leaves the bound alone.
         let (mut t0, mut t1) = (ray.t_min, ray.t_max);
         for a in 0..3 {
+            let f = if nonneg { far[a] } else { widen_far(far[a]) };
             if near[a] > t0 {
                 t0 = near[a];
             }
-            if far[a] < t1 {
-                t1 = far[a];
+            if f < t1 {
+                t1 = f;
             }
         }
         (t0 <= t1).then_some((t0, t1))
