@@ -204,7 +204,10 @@ impl RayCtx {
             near: [nx, ny, nz],
             far: [fx, fy, fz],
             wt,
-            wt_org: glam::Vec3::new(o[kx], o[ky], o[kz]),
+            wt_org: {
+                let o = o.to_array();
+                glam::Vec3::new(o[kx], o[ky], o[kz])
+            },
         };
         Some((ctx, fused))
     }
