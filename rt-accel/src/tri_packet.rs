@@ -122,7 +122,7 @@ impl Verts for [TriPacket; 2] {
 /// # Safety
 /// As [`Lanes`]: `V::L`'s methods may run here.
 #[inline(always)]
-unsafe fn lanes<V: Verts>(
+unsafe fn lanes<V: Verts, const EARLY: bool>(
     tris: &V,
     ctx: &RayCtx,
     t_max: f32,
@@ -158,6 +158,12 @@ unsafe fn lanes<V: Verts>(
         let on_edge = u.eq_mask(zero) | v.eq_mask(zero) | w.eq_mask(zero);
         let neg = u.lt_mask(zero) | v.lt_mask(zero) | w.lt_mask(zero);
         let pos = zero.lt_mask(u) | zero.lt_mask(v) | zero.lt_mask(w);
+        let all = <V::L as Lanes>::ALL;
+        // A lane the ray passes through has edge functions of one sign
+        // (exactly one of `neg`, `pos`; neither for unused NaN lanes).
+        if EARLY && ((neg ^ pos) | on_edge) & all == 0 {
+            return (0, 0, zero.to_lanes());
+        }
         let det = u.add(v).add(w);
         let tt = u.mul(sz.mul(az)).add(v.mul(sz.mul(bz))).add(w.mul(sz.mul(cz)));
         let t = tt.mul(splat(1.0).div(det));
@@ -166,7 +172,6 @@ unsafe fn lanes<V: Verts>(
         let in_range = splat(ctx.ray.t_min).le_mask(t) & t.le_mask(splat(t_max)) & t.lt_mask(inf);
         // As the scalar test: an overflowed `det` is no hit.
         let finite = det.lt_mask(inf) & splat(f32::NEG_INFINITY).lt_mask(det);
-        let all = <V::L as Lanes>::ALL;
         let ok = !(neg & pos) & !det.eq_mask(zero) & finite & in_range & !on_edge & all;
         (ok, on_edge & all, t.to_lanes())
     }
@@ -212,7 +217,7 @@ pub(crate) unsafe fn any_x8(packets: &[TriPacket], ctx: &RayCtx, t_max: f32) -> 
     let (pairs, rest) = packets.as_chunks::<2>();
     for pair in pairs {
         // SAFETY: the caller guarantees AVX.
-        if any_lane(pair, unsafe { lanes(pair, ctx, t_max) }, ctx, t_max) {
+        if any_lane(pair, unsafe { lanes::<_, false>(pair, ctx, t_max) }, ctx, t_max) {
             return true;
         }
     }
@@ -236,7 +241,7 @@ impl Primitive for TriPacket {
     #[inline(always)]
     fn closest(&self, item: u32, ctx: &RayCtx, best: &mut BestHit) {
         // SAFETY: four lanes run anywhere.
-        let (mut ok, mut edge, t) = unsafe { lanes(self, ctx, best.t) };
+        let (mut ok, mut edge, t) = unsafe { lanes::<_, true>(self, ctx, best.t) };
         while ok != 0 {
             let lane = ok.trailing_zeros();
             ok &= ok - 1;
@@ -262,7 +267,7 @@ impl Primitive for TriPacket {
     #[inline(always)]
     fn any(&self, ctx: &RayCtx, t_max: f32) -> bool {
         // SAFETY: four lanes run anywhere.
-        let found = unsafe { lanes(self, ctx, t_max) };
+        let found = unsafe { lanes::<_, false>(self, ctx, t_max) };
         any_lane(core::slice::from_ref(self), found, ctx, t_max)
     }
 
