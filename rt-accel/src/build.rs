@@ -23,7 +23,7 @@ use rt_core::{
 use crate::{
     BuildError, Bvh, CapsuleItem, MAX_DEPTH, SphereItem, TriPacket,
     check::triangle_vertices,
-    node::{ChildRef, MAX_ITEMS, MAX_LEAF_ITEMS, Node, WIDTH},
+    node::{ChildRef, MAX_ITEMS, MAX_LEAF_ITEMS, MAX_NODES, Node, WIDTH},
     prim::{Primitive, ShapeItem},
 };
 
@@ -444,6 +444,9 @@ fn convert<P: Primitive>(
                 ChildRef::leaf(first as u32, count as u32)
             } else {
                 let idx = nodes.len();
+                if idx >= MAX_NODES as usize {
+                    return Err(BuildError::TooManyPrimitives);
+                }
                 nodes.push(Node::EMPTY);
                 work.push((k, depth + 1));
                 ChildRef::inner(idx as u32)

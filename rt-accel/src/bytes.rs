@@ -11,8 +11,9 @@ use crate::{LoadError, MAX_DEPTH, node::Node, prim::Primitive, traverse::BvhRef}
 
 /// Magic bytes opening every serialized BVH.
 pub const MAGIC: [u8; 8] = *b"rtBVH4\0\0";
-/// Format version written by this crate.
-pub const VERSION: u32 = 1;
+/// Format version written by this crate. Version 2 stores inner child
+/// references as byte offsets (version 1: node indices).
+pub const VERSION: u32 = 2;
 const ENDIAN: u32 = 0x0102_0304;
 
 /// The header of a serialized BVH.
@@ -173,7 +174,11 @@ pub fn validate<P: Primitive>(
                 }
             } else {
                 let ci = c.index();
-                if ci <= i || ci >= nodes.len() {
+                // An offset between two nodes would floor to a valid index.
+                if !c.byte_offset().is_multiple_of(size_of::<Node>())
+                    || ci <= i
+                    || ci >= nodes.len()
+                {
                     return Err(LoadError::BadChild { node: i });
                 }
                 if ci != next {

@@ -25,7 +25,8 @@ pub enum BuildError {
     },
     /// Refit data do not match the BVH (different primitive count).
     RefitMismatch,
-    /// More primitives than the node layout can address (2²⁷ leaf items).
+    /// More primitives than the node layout can address (2²⁷ leaf items,
+    /// [`crate::MAX_NODES`] nodes).
     TooManyPrimitives,
     /// The builder produced a tree deeper than [`crate::MAX_DEPTH`].
     TooDeep,
@@ -71,7 +72,8 @@ pub enum LoadError {
     /// Zero-copy loading needs 16-byte aligned bytes; copy with
     /// `Bvh::from_bytes` instead.
     Misaligned,
-    /// A child reference points at or before its parent, or past the end.
+    /// A child reference points at or before its parent, past the end, or
+    /// between two nodes (an offset not a multiple of the node size).
     BadChild {
         /// The node holding the reference.
         node: usize,

@@ -91,7 +91,7 @@ pub use instance::{InstanceError, Instances, Object};
 pub use isa::{Isa, UnsupportedIsa};
 #[cfg(feature = "alloc")]
 pub use mesh::TriangleMesh;
-pub use node::{ChildRef, GROUPS, MAX_ITEMS, MAX_LEAF_ITEMS, Node, WIDTH};
+pub use node::{ChildRef, GROUPS, MAX_ITEMS, MAX_LEAF_ITEMS, MAX_NODES, NODE_BYTES, Node, WIDTH};
 pub use packet::PACKET;
 pub use prim::{BestHit, CapsuleItem, Primitive, SphereItem};
 pub use ray_ctx::RayCtx;

@@ -289,15 +289,19 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         }
     }
 
-    /// Inner node `c`.
+    /// Inner node `c`, found by its byte offset (no multiply on the
+    /// traversal's chain, see `node.rs`).
     #[inline(always)]
     pub(crate) fn node(&self, c: ChildRef) -> &'a Node {
-        debug_assert!(c.index() < self.nodes.len());
+        debug_assert!(
+            c.byte_offset().is_multiple_of(size_of::<Node>()) && c.index() < self.nodes.len()
+        );
         // SAFETY: traversals only follow references stored in the tree
         // (or the root of a non-empty tree), and every `BvhRef` was made
         // by `Bvh::as_ref` or `BvhRef::from_bytes`, which prove that each
-        // inner reference names an existing node (`validate`).
-        unsafe { self.nodes.get_unchecked(c.index()) }
+        // inner reference is the offset of an existing node, a multiple of
+        // its size (`validate`).
+        unsafe { &*self.nodes.as_ptr().byte_add(c.byte_offset()) }
     }
 
     /// The items `first..first + count` of a leaf reference.
@@ -317,8 +321,9 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 // The first two items: a leaf's usual size.
                 prefetch_bytes(it, count.min(2) * core::mem::size_of::<P>());
             }
-        } else if let Some(n) = self.nodes.get(c.index()) {
-            prefetch_bytes(n, core::mem::size_of::<Node>());
+        } else {
+            // A reference from the tree (see `node`).
+            prefetch_bytes(self.node(c), core::mem::size_of::<Node>());
         }
     }
 

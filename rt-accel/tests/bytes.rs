@@ -12,8 +12,8 @@ use std::sync::LazyLock;
 use proptest::prelude::*;
 use rt_accel::{
     BuildParams, Bvh, BvhRef, CapsuleItem, ChildRef, Header, LoadError, MAGIC, MAX_DEPTH,
-    MAX_ITEMS, Node, Primitive, SphereItem, TraversalStats, TriPacket, VERSION, WIDTH,
-    build_capsules, build_spheres, build_triangles,
+    MAX_ITEMS, MAX_NODES, NODE_BYTES, Node, Primitive, SphereItem, TraversalStats, TriPacket,
+    VERSION, WIDTH, build_capsules, build_spheres, build_triangles,
 };
 use rt_core::{
     Aabb, Ray,
@@ -312,7 +312,7 @@ fn child_refs_backwards_or_past_the_end_are_rejected() {
     assert_eq!(slots.len(), nodes.len() - 1, "every node but the root has one parent");
     for (i, s) in slots {
         let iu = i as u32;
-        for target in [iu, 0, iu.saturating_sub(1), n, n + 1000, (1 << 31) - 1] {
+        for target in [iu, 0, iu.saturating_sub(1), n, n + 1000, MAX_NODES - 1] {
             let bad = edit_nodes::<TriPacket>(&bytes, |nodes| {
                 nodes[i].children[s] = ChildRef::inner(target)
             });
@@ -320,6 +320,29 @@ fn child_refs_backwards_or_past_the_end_are_rejected() {
                 load_err::<TriPacket>(&bad),
                 LoadError::BadChild { node: i },
                 "node {i} slot {s} → {target}"
+            );
+        }
+    }
+}
+
+/// Inner references are byte offsets (format version 2): every offset
+/// between two nodes, even one inside the right node, is `BadChild`
+/// naming the node that holds it (its index would floor to a valid one).
+#[test]
+fn child_offsets_between_nodes_are_rejected() {
+    let bytes = tri_bvh().to_bytes();
+    let nodes = nodes_of(&bytes);
+    for (i, s) in child_slots(&nodes, true) {
+        let good = nodes[i].children[s];
+        assert_eq!(good.byte_offset(), good.index() * NODE_BYTES as usize);
+        for k in [1, 4, 16, 32, NODE_BYTES - 1] {
+            let bad = edit_nodes::<TriPacket>(&bytes, |nodes| {
+                nodes[i].children[s] = ChildRef(good.0 + k);
+            });
+            assert_eq!(
+                load_err::<TriPacket>(&bad),
+                LoadError::BadChild { node: i },
+                "{i} {s} +{k}"
             );
         }
     }
