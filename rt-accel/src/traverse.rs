@@ -737,9 +737,12 @@ pub(crate) unsafe fn box_lanes_fused(
         let (nx, fx) = slab(b, ctx, f, 0);
         let (ny, fy) = slab(b, ctx, f, 1);
         let (nz, fz) = slab(b, ctx, f, 2);
-        let t0 = nx.max(ny).max(nz.max(F32x8::splat(ctx.ray.t_min)));
-        let t1 = fx.min(fy).min(fz.min(F32x8::splat(t_max)));
-        (t0.le(t1), t0)
+        let (nxy, nzt) = (nx.max(ny), nz.max(F32x8::splat(ctx.ray.t_min)));
+        let (fxy, fzt) = (fx.min(fy), fz.min(F32x8::splat(t_max)));
+        // `max(nxy, nzt) ≤ min(fxy, fzt)` as four compares side by side
+        // (none of the values is NaN): one level shorter on the chain.
+        let entered = nxy.le(fxy).and(nxy.le(fzt)).and(nzt.le(fxy).and(nzt.le(fzt)));
+        (entered, nxy.max(nzt))
     }
 }
 
