@@ -7,7 +7,7 @@ use rt_accel::{
     BuildParams, BuildQuality, Bvh, Isa, TriPacket, build_capsules, build_spheres, build_triangles,
 };
 use rt_core::{
-    Ray,
+    Ray, SceneQuery,
     glam::Vec3,
     intersect::{Capsule, Sphere, intersect_triangle},
 };
@@ -145,7 +145,11 @@ proptest! {
                 let packet: &[Ray; 8] = chunk.try_into().unwrap();
                 let closest = view.closest_t_packet(packet);
                 let occluded = view.occluded_packet(packet);
+                // The renderer's entry point (single rays on the AVX
+                // kernels, packets on the others): whole hit records.
+                let records = SceneQuery::closest_hit_packet(&view, packet);
                 for (i, r) in packet.iter().enumerate() {
+                    prop_assert_eq!(records[i], view.closest_hit(r), "{} ray {}", isa, i);
                     // `t` and primitive; `item`/`lane` may name another
                     // reference to the same triangle (builds may split).
                     let th = |b: Option<rt_accel::BestHit>| b.map(|b| (b.t.to_bits(), b.prim));

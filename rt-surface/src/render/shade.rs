@@ -80,8 +80,9 @@ impl<S: ShadeScene> Ctx<'_, S> {
             pixel: 0,
             pending: Pending::default(),
         };
-        // Camera rays eight pixels of a row at a time, traced as a packet
-        // (`SceneQuery::closest_hit_packet`: the same hits as one by one);
+        // Camera rays eight pixels of a row at a time, through
+        // `SceneQuery::closest_hit_packet` (a BVH traces them as a packet
+        // or one by one, whichever its kernel does faster: the same hits);
         // each pixel keeps its own random stream for the rest of its path.
         let none = Ray::new(Vec3::NAN, Vec3::Z);
         for y in y0..y0 + th {
