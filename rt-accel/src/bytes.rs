@@ -7,7 +7,12 @@
 
 use rt_core::Aabb;
 
-use crate::{LoadError, MAX_DEPTH, node::Node, prim::Primitive, traverse::BvhRef};
+use crate::{
+    LoadError, MAX_DEPTH,
+    node::{NODE_BYTES, Node},
+    prim::Primitive,
+    traverse::BvhRef,
+};
 
 /// Magic bytes opening every serialized BVH.
 pub const MAGIC: [u8; 8] = *b"rtBVH4\0\0";
@@ -175,7 +180,7 @@ pub fn validate<P: Primitive>(
             } else {
                 let ci = c.index();
                 // An offset between two nodes would floor to a valid index.
-                if !c.byte_offset().is_multiple_of(size_of::<Node>())
+                if !c.byte_offset().is_multiple_of(NODE_BYTES as usize)
                     || ci <= i
                     || ci >= nodes.len()
                 {

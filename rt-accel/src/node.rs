@@ -12,7 +12,7 @@
 //! node's address and loads its boxes, one after the other. From an index
 //! the address takes a multiply by 224 (3 cycles on the chain); from an
 //! offset, an addition the load's addressing does (every single-ray row
-//! of `rt-report traversal` +4–10 %). It caps a tree at [`MAX_NODES`]
+//! of `rt-report traversal` +0.5–7.5 %). It caps a tree at [`MAX_NODES`]
 //! nodes, about 190 M triangles.
 //!
 //! Why eight: incoherent rays on million-triangle scenes are bound by the

@@ -294,7 +294,8 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     #[inline(always)]
     pub(crate) fn node(&self, c: ChildRef) -> &'a Node {
         debug_assert!(
-            c.byte_offset().is_multiple_of(size_of::<Node>()) && c.index() < self.nodes.len()
+            c.byte_offset().is_multiple_of(crate::NODE_BYTES as usize)
+                && c.index() < self.nodes.len()
         );
         // SAFETY: traversals only follow references stored in the tree
         // (or the root of a non-empty tree), and every `BvhRef` was made

@@ -28,25 +28,19 @@ impl WatertightRay {
     #[inline]
     #[must_use]
     pub fn new(ray: &Ray) -> Self {
-        use glam::{BVec3A, Vec3A, Vec3Swizzles as _};
         // `[kx, ky]` by `2·kz + (d_kz < 0)`: the next two axes in cyclic
         // order, swapped for a negative `d_kz` to keep the winding.
         const XY: [[usize; 2]; 6] = [[1, 2], [2, 1], [2, 0], [0, 2], [0, 1], [1, 0]];
-        let d = Vec3A::from(ray.direction);
-        let [x, y, z] = d.abs().to_array();
-        // The largest |d| (the first on ties), and the direction permuted
-        // to `[kx, ky, kz]`, chosen by arithmetic: a branch on it
-        // mispredicts for rays of random direction (a third of a missed
-        // incoherent ray's cost).
-        let (on_x, on_y) = ((x >= y) & (x >= z), y >= z);
-        let kz = usize::from(!on_x) * (2 - usize::from(on_y));
-        let p = Vec3A::select(BVec3A::splat(on_y), d.zxy(), d);
-        let p = Vec3A::select(BVec3A::splat(on_x), d.yzx(), p);
-        let neg = p.z < 0.0;
-        let p = Vec3A::select(BVec3A::splat(neg), p.yxz(), p);
-        let [kx, ky] = XY[2 * kz + usize::from(neg)];
-        let sz = 1.0 / p.z;
-        Self { axes: [kx, ky, kz], shear: Vec3::new(p.x * sz, p.y * sz, sz) }
+        // Indexed as an array (`Vec3`'s indexing is a match: branches).
+        let d = ray.direction.to_array();
+        let [x, y, z] = ray.direction.abs().to_array();
+        // The largest |d| (the first on ties), chosen by arithmetic: a
+        // branch on it mispredicts for rays of random direction (a third
+        // of a missed incoherent ray's cost).
+        let kz = usize::from(!((x >= y) & (x >= z))) * (2 - usize::from(y >= z));
+        let [kx, ky] = XY[2 * kz + usize::from(d[kz] < 0.0)];
+        let sz = 1.0 / d[kz];
+        Self { axes: [kx, ky, kz], shear: Vec3::new(d[kx] * sz, d[ky] * sz, sz) }
     }
 }
 
