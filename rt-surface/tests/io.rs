@@ -296,6 +296,69 @@ fn fuzz_regression_obj_bad_texcoord_index_is_an_error() {
     assert!(matches!(parse_obj(&bytes).unwrap_err().kind(), ReadErrorKind::Malformed { .. }));
 }
 
+/// Found by the `read_obj` fuzz target in CI: a texture-coordinate index
+/// far before the list (`f 1/-0025` with one `vt` read; the same case is
+/// in the next test) overflowed inside
+/// `tobj`; under the fuzzer's abort-on-panic hook, catching the panic did
+/// not help. Face indices are now checked before `tobj` sees them.
+#[test]
+fn fuzz_regression_obj_texcoord_index_before_the_list_is_checked_first() {
+    let parts: [&[u8]; 12] = [
+        b"\nv\x7f\0gv\x7f\0g\nvn\x0b9\t99\t9\n=~L \nvt\x0b19\t9  \t9",
+        b"99\x0b\nv\x7f\0gv\x0b\x0bg gg\x049\t99\nv\x0b\t9\t99\t9\n v\x0b9\t",
+        b"9\t9\nv\x0b\t9\t9\t9\nv\x0b\t9\t9\t9\n9\t999\t9\t\t99\t \n",
+        b"v\x0b\t9\t99\t9\n\0\0\0\0\0\0\0\x08v\x0b9\t9\t9\nf\x0b\t9\t9\t9\nv",
+        b"\x0b\t9\t9\t9\t\t99\t \nv\x0b\t9\r9\t9\nvK9\t999\t9\t\t99",
+        b"\t \nv\x0b\t9\t99\t9\nv\x0b9\t9\t9\nf\x0b\t9\t9\t9\n\x7f\nf\0g\t",
+        b"\ng\0g\t\ng\0\0\n\0\ng\x1a\0\nf\x0b\x0b/-05\nv\x0b9\t9\t9\t9\n=\x0b",
+        b"9ccYcccccccccccccc\x0b\t9\nv\x0b9\t9\t9\t9\n=\nv=",
+        b"v \t\t99\0\t\n99\x0b\t9\nv\x0b9\t9\t9\t9\n=\r9\n=9\t9\0\t\n",
+        b"99\x0b\t9\nv\x0b9\t9\t9\t9\n\t9\nv\x0b9\t9\t9\t9\n=\r9\nf\x0b1",
+        b"/-0025 05\x0b\x0b/-05\x0b\x0b/-0025 05\x0b\x0b/-05\nf\x0b1",
+        b"/-005 65 65\x0b1/-005 65 65",
+    ];
+    let bytes = parts.concat();
+    assert_eq!(bytes.len(), 420);
+    let e = parse_obj(&bytes).unwrap_err();
+    // Its first bad index is an earlier one-vertex face without a vertex
+    // index (tobj skips one-vertex faces, so it never failed there).
+    assert!(e.to_string().contains("OBJ line 27: face vertex \"/-05\""), "{e}");
+}
+
+/// Face indices are checked as OBJ defines them: from 1, negative counts
+/// back from the items read so far, forward references are allowed, and
+/// texture coordinate or normal indices in a file without that list are
+/// ignored (as tobj does).
+#[test]
+fn obj_face_indices_follow_the_format() {
+    let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    for ok in [
+        format!("{tri}f -3 -2 -1\n"),
+        format!("f 1 2 3\n{tri}"),
+        format!("{tri}f 1/7 2/7 3/7\n"),
+        format!("{tri}f 1//9 2//9 3//9\n"),
+        format!("{tri}vt 0 0\nf 1/-1 2/1 3/-1\n"),
+    ] {
+        assert_eq!(parse_obj(ok.as_bytes()).unwrap().indices, [[0, 1, 2]], "{ok}");
+    }
+    for (bad, message) in [
+        (format!("{tri}f -4 -2 -1\n"), "line 4: vertex index -4, with 3 before this line"),
+        (format!("f -1 2 3\n{tri}"), "line 1: vertex index -1, with 0 before this line"),
+        (format!("{tri}f 1 2 4\n"), "line 4: vertex index 4, with 3 in the file"),
+        (format!("{tri}vt 0 0\nf 1/2 2/1 3/1\n"), "line 5: texture coordinate index 2, with 1"),
+        (format!("{tri}vt 0 0\nf 1/-25 2/1 3/1\n"), "texture coordinate index -25, with 1"),
+        (format!("{tri}vn 0 0 1\nf 1//-2 2//1 3//1\n"), "line 5: normal index -2, with 1"),
+        (format!("{tri}vn 0 0 1\nf 1//0 2//1 3//1\n"), "line 5: normal index 0"),
+        (format!("{tri}vt 0 0\nf 1/-9223372036854775808 2 3\n"), "index -9223372036854775808"),
+        (format!("{tri}vn 0 0 1\nf 1//9223372036854775807 2 3\n"), "index 9223372036854775807"),
+        (format!("{tri}f /1 2 3\n"), "line 4: face vertex \"/1\" has no vertex index"),
+    ] {
+        let e = parse_obj(bad.as_bytes()).unwrap_err();
+        assert!(e.to_string().contains(message), "{bad}: {e}");
+        assert_eq!(e.to_string().lines().count(), 1);
+    }
+}
+
 /// Parse errors wrap the parser's own error as their source, and print
 /// its first line on one line of their own.
 #[test]

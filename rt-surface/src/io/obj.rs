@@ -1,6 +1,10 @@
 //! Wavefront OBJ, through `tobj`.
 
-use alloc::{format, string::ToString, vec::Vec};
+use alloc::{
+    format,
+    string::{String, ToString},
+    vec::Vec,
+};
 
 use super::{
     MeshData, ReadError,
@@ -17,7 +21,8 @@ use super::{
 /// # Errors
 /// [`ReadErrorKind::Malformed`](super::ReadErrorKind::Malformed) wrapping
 /// `tobj`'s error, with the line it is about where it can be found, or for
-/// an index that makes `tobj` itself fail.
+/// a face index outside its list (0, past the end of the file's list, or
+/// counting back past the first item read), with its line.
 pub fn parse_obj(bytes: &[u8]) -> Result<MeshData, ReadError> {
     let options = tobj::LoadOptions {
         single_index: true,
@@ -25,14 +30,16 @@ pub fn parse_obj(bytes: &[u8]) -> Result<MeshData, ReadError> {
         ignore_points: true,
         ignore_lines: true,
     };
-    // tobj 4.0.5 indexes texture coordinates and normals with unchecked
-    // arithmetic (`f 1/-2` far past the list overflows, found by the
-    // `read_obj` fuzz target): its panic is caught and reported as a
-    // malformed file. (Under `panic = "abort"` it would still abort.)
+    // tobj 4.0.5 multiplies face indices unchecked (`f 1/-9` with fewer
+    // texture coordinates overflows): every index is checked here first,
+    // so tobj only sees indices into its lists. Its panics, should it have
+    // others, are still caught and reported as a malformed file (under
+    // `panic = "abort"` they would abort).
+    check_face_indices(bytes)?;
     let load =
         || tobj::load_obj_buf(&mut &bytes[..], &options, |_| Err(tobj::LoadError::OpenFileFailed));
     let (models, _materials) = std::panic::catch_unwind(load)
-        .map_err(|_| malformed("OBJ: the parser failed on a bad index"))?
+        .map_err(|_| malformed("OBJ: the parser failed"))?
         .map_err(|e| match error_line(bytes, &e) {
             Some(line) => parse_error(format!("OBJ line {line}"), e),
             None => parse_error("OBJ", e),
@@ -66,15 +73,6 @@ fn error_line(bytes: &[u8], e: &tobj::LoadError) -> Option<usize> {
     use tobj::LoadError as E;
     let text = core::str::from_utf8(bytes).ok()?;
     let floats = |rest: &[&str]| rest.iter().all(|t| t.parse::<f32>().is_ok());
-    let count =
-        |tag: &str| text.lines().filter(|l| l.split_whitespace().next() == Some(tag)).count();
-    let (nv, nt, nn) = (count("v"), count("vt"), count("vn"));
-    // Index `k` (1-based, negative from the end) of a list of `len` items.
-    let index_ok = |t: &str, len: usize| match t.parse::<i64>() {
-        Ok(k) if k > 0 => usize::try_from(k).is_ok_and(|k| k <= len),
-        Ok(k) if k < 0 => usize::try_from(-k).is_ok_and(|k| k <= len),
-        _ => false,
-    };
     let bad = |tag: &str, words: &[&str]| -> bool {
         let rest = &words[1..];
         match (e, tag) {
@@ -90,20 +88,6 @@ fn error_line(bytes: &[u8], e: &tobj::LoadError) -> Option<usize> {
                     .enumerate()
                     .any(|(i, t)| !(t.is_empty() && i > 0) && t.parse::<i64>().is_err())
             }),
-            (
-                E::FaceVertexOutOfBounds | E::FaceTexCoordOutOfBounds | E::FaceNormalOutOfBounds,
-                "f",
-            ) => {
-                let slot = match e {
-                    E::FaceVertexOutOfBounds => 0,
-                    E::FaceTexCoordOutOfBounds => 1,
-                    _ => 2,
-                };
-                let len = [nv, nt, nn][slot];
-                rest.iter().any(|r| {
-                    r.split('/').nth(slot).is_some_and(|t| !t.is_empty() && !index_ok(t, len))
-                })
-            }
             _ => false,
         }
     };
@@ -112,4 +96,68 @@ fn error_line(bytes: &[u8], e: &tobj::LoadError) -> Option<usize> {
         let tag = *words.first()?;
         bad(tag, &words).then_some(i + 1)
     })
+}
+
+/// The lists a face vertex `v/vt/vn` indexes, in its slot order.
+const LISTS: [(&str, &str); 3] = [("v", "vertex"), ("vt", "texture coordinate"), ("vn", "normal")];
+
+/// Checks every face index of `bytes` the way the OBJ format defines
+/// them: `k > 0` is the k-th item of its list in the file, `k < 0` counts
+/// back from the last item read before the face, `0` is no item. Texture
+/// coordinate and normal indices are not checked in a file without that
+/// list (tobj leaves them out). Lines are read as tobj reads them, up to
+/// the first that is not UTF-8 (where tobj stops with its own error);
+/// indices that are not integers are left to tobj's error too.
+fn check_face_indices(bytes: &[u8]) -> Result<(), ReadError> {
+    let lines = || bytes.split(|&b| b == b'\n').map_while(|l| core::str::from_utf8(l).ok());
+    let slot = |tag: &str| LISTS.iter().position(|&(t, _)| t == tag);
+    let mut total = [0usize; 3];
+    for line in lines() {
+        if let Some(s) = line.split_whitespace().next().and_then(slot) {
+            total[s] += 1;
+        }
+    }
+    let mut read = [0usize; 3];
+    for (number, line) in lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("f") => {}
+            tag => {
+                if let Some(s) = tag.and_then(slot) {
+                    read[s] += 1;
+                }
+                continue;
+            }
+        }
+        for vertex in words {
+            for (s, t) in vertex.split('/').enumerate().take(3) {
+                let what = LISTS[s].1;
+                let bad = |why: String| malformed(format!("OBJ line {}: {why}", number + 1));
+                if t.is_empty() {
+                    if s == 0 {
+                        return Err(bad(format!("face vertex {vertex:?} has no vertex index")));
+                    }
+                    continue;
+                }
+                let Ok(k) = t.parse::<i64>() else { continue };
+                if s > 0 && total[s] == 0 {
+                    continue;
+                }
+                let ok = match k {
+                    0 => return Err(bad(format!("{what} index 0 (OBJ counts from 1)"))),
+                    1.. => k.unsigned_abs() <= total[s] as u64,
+                    _ => k.unsigned_abs() <= read[s] as u64,
+                };
+                if !ok {
+                    let (n, place) = if k > 0 {
+                        (total[s], "in the file")
+                    } else {
+                        (read[s], "before this line")
+                    };
+                    return Err(bad(format!("{what} index {k}, with {n} {place}")));
+                }
+            }
+        }
+    }
+    Ok(())
 }
