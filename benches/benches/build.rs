@@ -1,4 +1,5 @@
-//! Criterion: BVH build time per obvhs preset.
+//! Criterion: BVH build time per preset (obvhs's up to medium, and the
+//! binned SAH builder).
 // A std-only tool crate: the no_std import lints guard the libraries.
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 // criterion_group! generates undocumented items.

@@ -1,7 +1,8 @@
 //! # rt-accel
 //!
 //! An 8-wide bounding volume hierarchy for the `rt` crates. Trees are built
-//! with [obvhs](https://crates.io/crates/obvhs)'s PLOC builder (feature
+//! by a binned SAH builder of our own (the default) or with
+//! [obvhs](https://crates.io/crates/obvhs)'s PLOC presets (feature
 //! `obvhs`), then converted to a layout of our own: plain `bytemuck::Pod`
 //! nodes holding eight child boxes in structure-of-arrays form, tested four
 //! per SSE pass, and leaves of triangle packets tested four at a time with
@@ -71,6 +72,8 @@ mod prim;
 mod ray_ctx;
 #[cfg(feature = "alloc")]
 mod refit;
+#[cfg(feature = "obvhs")]
+mod sah;
 #[cfg(feature = "alloc")]
 mod scene;
 mod simd;
