@@ -8,12 +8,17 @@
 //! the least surface area heuristic,
 //!
 //! ```text
-//! cost(split) = n_left · A(left) + n_right · A(right),
+//! cost(split) = ⌈n_left / k⌉ · A(left) + ⌈n_right / k⌉ · A(right),
 //! ```
 //!
-//! with `A` the surface area of the side's box and `n` its primitive
-//! count (the node's own area is the same for every split, so it drops
-//! out). Nodes of at most `leaf` primitives become leaves; the collapse
+//! with `A` the surface area of the side's box, `n` its primitive count
+//! and `k` the primitives a leaf item holds (4 for triangle packets, as
+//! Embree counts its Triangle4 blocks; 1 for spheres and capsules): the
+//! leaf items the side would need (the node's own area is the same for
+//! every split, so it drops out). Counting items, not triangles, favours
+//! splits into full packets: 3.45 → 3.89 triangles a packet on the
+//! terrain, 9–13 % fewer nodes, single-ray rows +2–7 % (two interleaved
+//! runs; the first had terrain primary rays −3 %, the second +2.5 %). Nodes of at most `leaf` primitives become leaves; the collapse
 //! then merges subtrees into the final leaves by the same heuristic.
 //!
 //! **Invariants.** Every primitive is in exactly one leaf; no leaf holds
@@ -90,7 +95,9 @@ fn best_split(
     boxes: &[OAabb],
     cents: &[Vec3A],
     binning: &Binning,
+    block: u32,
 ) -> Option<(usize, usize)> {
+    let items = |n: u32| f64::from(n.div_ceil(block));
     let mut bins = [[Bin::EMPTY; BINS]; 3];
     for &i in ids {
         let (b, c) = (&boxes[i as usize], cents[i as usize]);
@@ -108,14 +115,14 @@ fn best_split(
         for k in (1..BINS).rev() {
             b = b.union(&row[k].bounds);
             n += row[k].count;
-            right[k] = if n == 0 { f64::NAN } else { half_area(&b) * f64::from(n) };
+            right[k] = if n == 0 { f64::NAN } else { half_area(&b) * items(n) };
         }
         let (mut b, mut n) = (OAabb::INVALID, 0u32);
         for k in 1..BINS {
             b = b.union(&row[k - 1].bounds);
             n += row[k - 1].count;
             // Both sides must hold a primitive (NaN `right` otherwise).
-            let cost = half_area(&b) * f64::from(n) + right[k];
+            let cost = half_area(&b) * items(n) + right[k];
             if n > 0 && best.is_none_or(|(c, ..)| cost < c) && !cost.is_nan() {
                 best = Some((cost, axis, k));
             }
@@ -131,10 +138,11 @@ fn ceil_log2(n: usize) -> usize {
 
 /// The binary tree over `boxes` (finite boxes, not empty), leaves of at
 /// most `leaf ≥ 1` primitives no deeper than `max_depth ≥ ⌈log₂
-/// boxes.len()⌉` (the builder passes [`crate::MAX_DEPTH`]): see the module
-/// documentation.
-pub(crate) fn build_bvh2(boxes: &[OAabb], leaf: usize, max_depth: usize) -> Bvh2 {
-    debug_assert!(!boxes.is_empty() && leaf >= 1 && ceil_log2(boxes.len()) <= max_depth);
+/// boxes.len()⌉` (the builder passes [`crate::MAX_DEPTH`]), splits costed
+/// in leaf items of `block ≥ 1` primitives: see the module documentation.
+pub(crate) fn build_bvh2(boxes: &[OAabb], leaf: usize, block: u32, max_depth: usize) -> Bvh2 {
+    debug_assert!(!boxes.is_empty() && leaf >= 1 && block >= 1);
+    debug_assert!(ceil_log2(boxes.len()) <= max_depth);
     let cents: Vec<Vec3A> = boxes.iter().map(centroid).collect();
     let mut ids: Vec<u32> = (0..boxes.len() as u32).collect();
     let mut nodes = vec![Bvh2Node::default()];
@@ -154,7 +162,7 @@ pub(crate) fn build_bvh2(boxes: &[OAabb], leaf: usize, max_depth: usize) -> Bvh2
         }
         let binning = Binning::new(&cb);
         let split = if depth + ceil_log2(n) < max_depth {
-            best_split(part, boxes, &cents, &binning)
+            best_split(part, boxes, &cents, &binning, block)
         } else {
             None
         };
@@ -249,7 +257,7 @@ mod tests {
             .map(|i| unit(i as f32))
             .chain((0..12).map(|i| unit(1000.0 + i as f32)))
             .collect();
-        let b2 = build_bvh2(&boxes, 4, MAX_DEPTH);
+        let b2 = build_bvh2(&boxes, 4, 1, MAX_DEPTH);
         check_partition(&b2, 16, 4);
         let root = &b2.nodes[0];
         let left = &b2.nodes[root.first_index as usize];
@@ -266,17 +274,32 @@ mod tests {
     fn takes_the_split_of_least_cost() {
         let boxes: Vec<OAabb> =
             (0..15).map(|i| unit(i as f32 * 0.01)).chain([unit(500.0)]).collect();
-        let b2 = build_bvh2(&boxes, 4, MAX_DEPTH);
+        let b2 = build_bvh2(&boxes, 4, 1, MAX_DEPTH);
         let root = b2.nodes[0].first_index as usize;
         let sizes = [root, root + 1].map(|k| prims_under(&b2, k));
         assert_eq!(sizes.iter().min(), Some(&1), "{sizes:?}");
+    }
+
+    /// Splits are costed in leaf items: five touching boxes, a gap of 2,
+    /// then three. Counting primitives, the gap is worth keeping (5 | 3);
+    /// counting packets of four, two full packets are cheaper (4 | 4).
+    #[test]
+    fn splits_are_costed_in_leaf_items() {
+        let boxes: Vec<OAabb> =
+            (0..5).map(|i| unit(i as f32)).chain((0..3).map(|i| unit(7.0 + i as f32))).collect();
+        for (block, left) in [(1, 5), (4, 4)] {
+            let b2 = build_bvh2(&boxes, 4, block, MAX_DEPTH);
+            let root = b2.nodes[0].first_index as usize;
+            let sizes = [root, root + 1].map(|k| prims_under(&b2, k));
+            assert!(sizes.contains(&left), "block {block}: {sizes:?}");
+        }
     }
 
     /// Identical boxes have no split: medians, down to the leaf size.
     #[test]
     fn identical_boxes_are_halved() {
         let boxes = vec![unit(3.0); 1000];
-        let ls = check_partition(&build_bvh2(&boxes, 3, MAX_DEPTH), 1000, 3);
+        let ls = check_partition(&build_bvh2(&boxes, 3, 1, MAX_DEPTH), 1000, 3);
         assert!(ls.iter().all(|(d, _)| *d <= ceil_log2(1000)));
     }
 
@@ -290,9 +313,9 @@ mod tests {
                 OAabb::new(Vec3A::new(x, 0.0, 0.0), Vec3A::new(x * 1.5, 1.0, 1.0))
             })
             .collect();
-        let ls = leaves(&build_bvh2(&boxes, 1, 12));
+        let ls = leaves(&build_bvh2(&boxes, 1, 1, 12));
         assert!(ls.iter().all(|(d, _)| *d <= 12), "{:?}", ls.iter().map(|l| l.0).max());
-        check_partition(&build_bvh2(&boxes, 1, MAX_DEPTH), 100, 1);
+        check_partition(&build_bvh2(&boxes, 1, 1, MAX_DEPTH), 100, 1);
     }
 
     /// Boxes near the f32 limits: no overflow to a NaN cost or bin.
@@ -305,6 +328,6 @@ mod tests {
                 OAabb::new(Vec3A::new(s, -m, i as f32), Vec3A::new(m, m, i as f32 + 1.0))
             })
             .collect();
-        check_partition(&build_bvh2(&boxes, 2, MAX_DEPTH), 64, 2);
+        check_partition(&build_bvh2(&boxes, 2, 4, MAX_DEPTH), 64, 2);
     }
 }
