@@ -183,7 +183,7 @@ pub fn build_triangles(
                         obvhs::aabb::Aabb::new(lo, hi)
                     })
                     .collect();
-                sah::build_bvh2(&boxes, sah_leaf(max_leaf), 4, MAX_DEPTH)
+                sah::build_bvh2(&boxes, sah_leaf(max_leaf), 4, MAX_DEPTH, build_threads())
             }
             _ => build_bvh2_from_tris(&tris, p, &mut Duration::default()),
         })
@@ -276,7 +276,9 @@ fn build_items<P: Primitive>(prims: Vec<P>, params: &BuildParams) -> Result<Bvh<
     let max_leaf = p.max_prims_per_leaf;
     let bvh2 = match params.quality {
         _ if boxes.is_empty() => None,
-        BuildQuality::BinnedSah => Some(sah::build_bvh2(&boxes, sah_leaf(max_leaf), 1, MAX_DEPTH)),
+        BuildQuality::BinnedSah => {
+            Some(sah::build_bvh2(&boxes, sah_leaf(max_leaf), 1, MAX_DEPTH, build_threads()))
+        }
         _ => Some(build_bvh2(&boxes, p, &mut Duration::default())),
     };
     let (nodes, items) = convert(
@@ -296,6 +298,11 @@ fn build_items<P: Primitive>(prims: Vec<P>, params: &BuildParams) -> Result<Bvh<
 /// 10 % costlier on the report's scenes).
 fn sah_leaf(max_leaf: u32) -> usize {
     max_leaf.min(4) as usize
+}
+
+/// Threads for the binned SAH builder: the cores the process may use.
+fn build_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, core::num::NonZero::get)
 }
 
 fn to_aabb(b: &obvhs::aabb::Aabb) -> Aabb {
