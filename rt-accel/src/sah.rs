@@ -22,7 +22,7 @@
 //! then merges subtrees into the final leaves by the same heuristic.
 //!
 //! **Invariants.** Every primitive is in exactly one leaf; no leaf holds
-//! more than `leaf` primitives; no leaf is deeper than [`MAX_DEPTH`] (a
+//! more than `leaf` primitives; no leaf is deeper than `max_depth` (a
 //! node whose depth plus `⌈log₂ n⌉` reaches it is split at its median
 //! instead, which halves `n` and so keeps the sum from growing: without
 //! that, centroids spread over many orders of magnitude put all but one
