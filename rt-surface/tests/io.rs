@@ -298,9 +298,9 @@ fn fuzz_regression_obj_bad_texcoord_index_is_an_error() {
 
 /// Found by the `read_obj` fuzz target in CI: a texture-coordinate index
 /// far before the list (`f 1/-0025` with one `vt` read; the same case is
-/// in the next test) overflowed inside
-/// `tobj`; under the fuzzer's abort-on-panic hook, catching the panic did
-/// not help. Face indices are now checked before `tobj` sees them.
+/// in the next test) overflowed inside `tobj`; under the fuzzer's
+/// abort-on-panic hook, catching the panic did not help. Face indices are
+/// now checked before `tobj` sees them.
 #[test]
 fn fuzz_regression_obj_texcoord_index_before_the_list_is_checked_first() {
     let parts: [&[u8]; 12] = [
