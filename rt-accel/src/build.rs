@@ -356,9 +356,7 @@ impl Plan {
         let mut stack = alloc::vec![(0usize, false)];
         while let Some((i, done)) = stack.pop() {
             let node = &b2.nodes[i];
-            let (lo, hi) = (node.aabb().min.as_dvec3(), node.aabb().max.as_dvec3());
-            let e = hi - lo;
-            let area = e.x * e.y + e.y * e.z + e.z * e.x;
+            let area = sah::half_area(node.aabb());
             let leaf_cost = |p: u32| area * ITEM_COST * f64::from(items(p));
             if node.is_leaf() {
                 prims[i] = node.prim_count;

@@ -293,7 +293,7 @@ impl RayCtx {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use glam::Vec3;
     use rt_core::{Aabb, Ray};
 
@@ -318,15 +318,15 @@ mod tests {
     }
 
     /// Random bits: xorshift64.
-    struct Bits(u64);
+    pub(crate) struct Bits(pub(crate) u64);
     impl Bits {
-        fn next(&mut self) -> u64 {
+        pub(crate) fn next(&mut self) -> u64 {
             self.0 ^= self.0 << 13;
             self.0 ^= self.0 >> 7;
             self.0 ^= self.0 << 17;
             self.0
         }
-        fn unit(&mut self) -> f32 {
+        pub(crate) fn unit(&mut self) -> f32 {
             (self.next() >> 40) as f32 / (1u64 << 24) as f32
         }
         /// A float of any sign and any exponent from `2⁻¹⁴⁹` (subnormal)
