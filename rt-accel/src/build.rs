@@ -176,13 +176,7 @@ pub fn build_triangles(
     } else {
         Some(match params.quality {
             BuildQuality::BinnedSah => {
-                let boxes: Vec<_> = tris
-                    .iter()
-                    .map(|t| {
-                        let (lo, hi) = (t.v0.min(t.v1).min(t.v2), t.v0.max(t.v1).max(t.v2));
-                        obvhs::aabb::Aabb::new(lo, hi)
-                    })
-                    .collect();
+                let boxes: Vec<_> = tris.iter().map(obvhs::triangle::Triangle::aabb).collect();
                 sah::build_bvh2(&boxes, sah_leaf(max_leaf), 4, MAX_DEPTH, build_threads())
             }
             _ => build_bvh2_from_tris(&tris, p, &mut Duration::default()),
