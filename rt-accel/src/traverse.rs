@@ -236,6 +236,12 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     /// on the 4-wide ones; `None` for an invalid ray.
     #[inline(always)]
     fn ray_constants<const AVX: bool>(&self, ray: &Ray) -> Option<(RayCtx, Fused)> {
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            // SAFETY: `AVX` kernels run only inside the functions compiled
+            // with AVX, called only where the CPU has it (as `box_test`).
+            return unsafe { RayCtx::new_fused_avx(ray, self.fused) };
+        }
         if AVX {
             RayCtx::new_fused(ray, self.fused)
         } else {
