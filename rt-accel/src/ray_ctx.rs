@@ -236,9 +236,11 @@ impl RayCtx {
             _mm256_cmp_ps, _mm256_loadu_ps, _mm256_movemask_ps, _mm256_set1_epi32, _mm256_set1_ps,
             _mm256_setzero_ps,
         };
+        const { assert!(size_of::<Ray>() == 32 && align_of::<Ray>() == 4) };
         // SAFETY: the caller guarantees AVX. `Ray` is `repr(C)`, eight
-        // `f32`s (origin, direction, t_min, t_max): the loads read inside
-        // it. The permutation table is indexed below its length.
+        // `f32`s (origin, direction, t_min, t_max; size checked above):
+        // the loads read inside it. The permutation table is indexed below
+        // its length.
         unsafe {
             let p = core::ptr::from_ref(ray).cast::<f32>();
             // [ox oy oz dx | dy dz t_min t_max]
