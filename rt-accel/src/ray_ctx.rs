@@ -276,24 +276,38 @@ impl RayCtx {
                 shear: glam::Vec3A::from(shear).into(),
             };
             let wt_org = glam::Vec3A::from(_mm_permutevar_ps(o, ctrl)).into();
-            let nonneg = ray.t_min >= 0.0;
             let inv = glam::Vec3A::from(_mm_div_ps(_mm_set1_ps(1.0), d));
-            let inv_far = if nonneg { inv * FAR_INV_SCALE } else { inv };
             let (near, far) = NEAR_FAR[neg];
-            let fused =
-                Fused::from_parts(glam::Vec3A::from(o), inv, inv_far, nonneg && tree_in_range);
-            let ctx = Self {
-                ray: *ray,
-                inv1: inv,
-                inv_far,
-                far_up: if nonneg { 1.0 } else { SLAB_FAR_SCALE },
-                far_down: if nonneg { 1.0 } else { SLAB_FAR_SCALE_NEG },
-                near,
-                far,
-                wt,
-                wt_org,
-            };
+            let ctx = Self::assemble(ray, inv, near, far, wt, wt_org);
+            let enable = ray.t_min >= 0.0 && tree_in_range;
+            let fused = Fused::from_parts(glam::Vec3A::from(o), inv, ctx.inv_far, enable);
             Some((ctx, fused))
+        }
+    }
+
+    /// The context of a valid `ray` from what its constructors compute:
+    /// the reciprocal direction, the near and far row offsets and the
+    /// watertight constants.
+    #[inline(always)]
+    fn assemble(
+        ray: &Ray,
+        inv: glam::Vec3A,
+        near: [u8; 3],
+        far: [u8; 3],
+        wt: WatertightRay,
+        wt_org: glam::Vec3,
+    ) -> Self {
+        let nonneg = ray.t_min >= 0.0;
+        Self {
+            ray: *ray,
+            inv1: inv,
+            inv_far: if nonneg { inv * FAR_INV_SCALE } else { inv },
+            far_up: if nonneg { 1.0 } else { SLAB_FAR_SCALE },
+            far_down: if nonneg { 1.0 } else { SLAB_FAR_SCALE_NEG },
+            near,
+            far,
+            wt,
+            wt_org,
         }
     }
 
@@ -312,31 +326,20 @@ impl RayCtx {
         let (ny, fy) = sel(1);
         let (nz, fz) = sel(2);
         let wt = WatertightRay::new(ray);
-        let nonneg = ray.t_min >= 0.0;
         let [kx, ky, kz] = wt.axes;
         let inv = glam::Vec3A::from(d).recip();
-        let inv_far = if nonneg { inv * FAR_INV_SCALE } else { inv };
+        // Indexed as an array: `Vec3`'s own indexing is a match, which
+        // compiled to branches on the axes (missed random rays 35 %
+        // slower).
+        let wt_org = {
+            let o = o.to_array();
+            glam::Vec3::new(o[kx], o[ky], o[kz])
+        };
+        let ctx = Self::assemble(ray, inv, [nx, ny, nz], [fx, fy, fz], wt, wt_org);
         let fused = if FUSED {
-            Fused::from_parts(o.into(), inv, inv_far, nonneg && tree_in_range)
+            Fused::from_parts(o.into(), inv, ctx.inv_far, ray.t_min >= 0.0 && tree_in_range)
         } else {
             Fused::OFF
-        };
-        let ctx = Self {
-            ray: *ray,
-            inv1: inv,
-            inv_far,
-            far_up: if nonneg { 1.0 } else { SLAB_FAR_SCALE },
-            far_down: if nonneg { 1.0 } else { SLAB_FAR_SCALE_NEG },
-            near: [nx, ny, nz],
-            far: [fx, fy, fz],
-            wt,
-            // Indexed as an array: `Vec3`'s own indexing is a match, which
-            // compiled to branches on the axes (missed random rays 35 %
-            // slower).
-            wt_org: {
-                let o = o.to_array();
-                glam::Vec3::new(o[kx], o[ky], o[kz])
-            },
         };
         Some((ctx, fused))
     }
