@@ -135,8 +135,8 @@ static PERM: [[i32; 4]; 8] = [
 ];
 
 /// `RayCtx::near` and `RayCtx::far` by the direction's sign bits (bit
-/// `a` set: axis `a` negative).
-#[cfg(target_arch = "x86_64")]
+/// `a` set: axis `a` negative): the near plane's row is `2·a + 1` for a
+/// negative direction, `2·a` otherwise.
 static NEAR_FAR: [([u8; 3], [u8; 3]); 8] = {
     let mut t = [([0; 3], [0; 3]); 8];
     let mut m = 0;
@@ -204,18 +204,20 @@ impl RayCtx {
 
     /// [`RayCtx::new`] with the fused node test's constants too, on where
     /// the test covers the ray and `tree_in_range` (the BVH's boxes lie in
-    /// its range, [`crate::traverse::fits_fused`]): for the single-ray AVX
-    /// kernels, which made here (not by a separate call) keep them in
-    /// registers. Kept beside the context, not in it: packets and streams,
-    /// which store a context per ray, ran 2–11 % slower with the larger
-    /// one.
-    #[inline(always)]
+    /// its range, [`crate::traverse::fits_fused`]). The kernels that use
+    /// them (the single-ray AVX ones) build them with
+    /// [`RayCtx::new_fused_avx`]; this portable form is what the tests
+    /// check that one and the fused test against. Kept beside the
+    /// context, not in it: packets and streams, which store a context per
+    /// ray, ran 2–11 % slower with the larger one.
+    #[cfg(test)]
     #[must_use]
     pub(crate) fn new_fused(ray: &Ray, tree_in_range: bool) -> Option<(Self, Fused)> {
         Self::build::<true>(ray, tree_in_range)
     }
 
-    /// [`RayCtx::new_fused`], computed with SSE/AVX instructions: the same
+    /// The constants of `RayCtx::new_fused` (the portable form, which the
+    /// tests keep), computed with SSE/AVX instructions: the same
     /// values, bit for bit (the test `avx_setup_equals_the_portable_one`
     /// checks every field), in a third fewer instructions. The portable
     /// form checked the ray field by field with a branch each, found the
@@ -318,13 +320,7 @@ impl RayCtx {
         }
         let o = ray.origin;
         let d = ray.direction;
-        let sel = |a: u8| {
-            let neg = u8::from(d[usize::from(a)].is_sign_negative());
-            (ROW * (2 * a + neg), ROW * (2 * a + 1 - neg))
-        };
-        let (nx, fx) = sel(0);
-        let (ny, fy) = sel(1);
-        let (nz, fz) = sel(2);
+        let (near, far) = NEAR_FAR[d.is_negative_bitmask() as usize & 7];
         let wt = WatertightRay::new(ray);
         let [kx, ky, kz] = wt.axes;
         let inv = glam::Vec3A::from(d).recip();
@@ -335,7 +331,7 @@ impl RayCtx {
             let o = o.to_array();
             glam::Vec3::new(o[kx], o[ky], o[kz])
         };
-        let ctx = Self::assemble(ray, inv, [nx, ny, nz], [fx, fy, fz], wt, wt_org);
+        let ctx = Self::assemble(ray, inv, near, far, wt, wt_org);
         let fused = if FUSED {
             Fused::from_parts(o.into(), inv, ctx.inv_far, ray.t_min >= 0.0 && tree_in_range)
         } else {
@@ -462,22 +458,32 @@ pub(crate) mod tests {
         }
     }
 
-    /// Every field of a context and its fused constants, as bits.
-    fn ctx_bits(c: &(RayCtx, Fused)) -> alloc::vec::Vec<u32> {
+    /// Every field of a context and its fused constants, as bits (an
+    /// array: the crate's tests also build without `alloc`).
+    fn ctx_bits(c: &(RayCtx, Fused)) -> [u32; 44] {
         let (ctx, f) = c;
         let v3 = |v: glam::Vec3A| v.to_array().map(f32::to_bits);
-        let mut out = alloc::vec::Vec::new();
-        out.extend(v3(ctx.ray.origin.into()));
-        out.extend(v3(ctx.ray.direction.into()));
-        out.extend([ctx.ray.t_min, ctx.ray.t_max, ctx.far_up, ctx.far_down].map(f32::to_bits));
-        out.extend(v3(ctx.inv1).into_iter().chain(v3(ctx.inv_far)));
-        out.extend(ctx.near.iter().chain(&ctx.far).map(|&b| u32::from(b)));
-        out.extend(ctx.wt.axes.map(|a| a as u32));
-        out.extend(v3(ctx.wt.shear.into()).into_iter().chain(v3(ctx.wt_org.into())));
-        out.push(u32::from(f.on));
-        for v in [f.inv_near, f.off_near, f.inv_far, f.off_far] {
-            out.extend(v3(v));
+        let scalars = [ctx.ray.t_min, ctx.ray.t_max, ctx.far_up, ctx.far_down].map(f32::to_bits);
+        let bytes = ctx.near.iter().chain(&ctx.far).map(|&b| u32::from(b));
+        let fields = v3(ctx.ray.origin.into())
+            .into_iter()
+            .chain(v3(ctx.ray.direction.into()))
+            .chain(scalars)
+            .chain(v3(ctx.inv1))
+            .chain(v3(ctx.inv_far))
+            .chain(bytes)
+            .chain(ctx.wt.axes.map(|a| a as u32))
+            .chain(v3(ctx.wt.shear.into()))
+            .chain(v3(ctx.wt_org.into()))
+            .chain([u32::from(f.on)])
+            .chain([f.inv_near, f.off_near, f.inv_far, f.off_far].into_iter().flat_map(v3));
+        let mut out = [0; 44];
+        let mut n = 0;
+        for (o, x) in out.iter_mut().zip(fields) {
+            *o = x;
+            n += 1;
         }
+        assert_eq!(n, 44);
         out
     }
 

@@ -242,11 +242,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             // with AVX, called only where the CPU has it (as `box_test`).
             return unsafe { RayCtx::new_fused_avx(ray, self.fused) };
         }
-        if AVX {
-            RayCtx::new_fused(ray, self.fused)
-        } else {
-            RayCtx::new(ray).map(|c| (c, Fused::OFF))
-        }
+        RayCtx::new(ray).map(|c| (c, Fused::OFF))
     }
 
     /// [`Self::occluded_kernel`] over the subtree `start` only.
