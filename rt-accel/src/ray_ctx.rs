@@ -422,14 +422,20 @@ pub(crate) mod tests {
     /// The fused test of one box, in scalars (`f32::mul_add` rounds once,
     /// as the kernel's multiply-add does): `(admitted, entry distance)`.
     fn fused_scalar(ctx: &RayCtx, fz: &Fused, b: &Aabb, t_max: f32) -> (bool, f32) {
-        let (mut t0, mut t1) = (ctx.ray.t_min, t_max);
+        // `+ 0.0` makes `−0` `+0`, as the lanes' integer maximum with 0 does.
+        let (mut t0, mut t1) = (ctx.ray.t_min + 0.0, t_max + 0.0);
+        let mut far_sign = false;
         for a in 0..3 {
             let neg = ctx.ray.direction[a].is_sign_negative();
             let (n, f) = if neg { (b.max[a], b.min[a]) } else { (b.min[a], b.max[a]) };
             t0 = t0.max(n.mul_add(fz.inv_near[a], fz.off_near[a]));
-            t1 = t1.min(f.mul_add(fz.inv_far[a], fz.off_far[a]));
+            let f = f.mul_add(fz.inv_far[a], fz.off_far[a]);
+            far_sign |= f.is_sign_negative();
+            t1 = t1.min(f);
         }
-        (t0 <= t1, t0)
+        // The lanes compare bits as integers: a far distance with the sign
+        // bit set, `−0` included, rejects the box.
+        (t0 <= t1 && !far_sign, t0)
     }
 
     /// Random bits: xorshift64.
@@ -607,8 +613,18 @@ pub(crate) mod tests {
                 node.set_child_bounds(slot, *b);
                 node.children[slot] = crate::node::ChildRef::leaf(0, 1);
             }
-            let t_min = if g.next().is_multiple_of(4) { 0.0 } else { g.unit() * scale };
-            let t_max = if g.next().is_multiple_of(2) { f32::INFINITY } else { g.unit() * 4.0 };
+            // Zeros of both signs at either end (the lanes compare bits).
+            let t_min = match g.next() % 8 {
+                0 => -0.0,
+                1 => 0.0,
+                _ => g.unit() * scale,
+            };
+            let t_max = match g.next() % 16 {
+                0 => -0.0,
+                1 => 0.0,
+                2..=8 => f32::INFINITY,
+                _ => g.unit() * 4.0,
+            };
             let ray = Ray::with_range(o, d, t_min, t_max);
             let Some((ctx, fz)) = RayCtx::new_fused(&ray, node.within(super::FUSED_RANGE)) else {
                 continue;

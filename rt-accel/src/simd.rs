@@ -219,6 +219,11 @@ mod avx {
         pub(crate) unsafe fn and(self, o: Self) -> Self {
             Self(unsafe { _mm256_and_ps(self.0, o.0) })
         }
+        /// Bitwise exclusive or.
+        #[inline(always)]
+        pub(crate) unsafe fn xor(self, o: Self) -> Self {
+            Self(unsafe { _mm256_xor_ps(self.0, o.0) })
+        }
         /// Every lane holding the bits of `bits` (not a float value: for
         /// [`F32x8::and`] / [`F32x8::or`] and [`F32x8::to_bits`]).
         #[inline(always)]
@@ -229,6 +234,41 @@ mod avx {
         #[inline(always)]
         pub(crate) fn to_bits(self) -> [u32; 8] {
             bytemuck::cast(self.0)
+        }
+        /// The lanes' bits compared as signed 32-bit integers (AVX2): the
+        /// larger of each pair. For floats with the sign bit clear (`+0`
+        /// to `+∞`, no NaN) that is the larger float; every float with the
+        /// sign bit set (`−0`, negatives) is below all of those. One cycle
+        /// where the float maximum takes four.
+        #[inline(always)]
+        pub(crate) unsafe fn max_bits(self, o: Self) -> Self {
+            Self(unsafe {
+                _mm256_castsi256_ps(_mm256_max_epi32(
+                    _mm256_castps_si256(self.0),
+                    _mm256_castps_si256(o.0),
+                ))
+            })
+        }
+        /// [`F32x8::max_bits`]'s minimum.
+        #[inline(always)]
+        pub(crate) unsafe fn min_bits(self, o: Self) -> Self {
+            Self(unsafe {
+                _mm256_castsi256_ps(_mm256_min_epi32(
+                    _mm256_castps_si256(self.0),
+                    _mm256_castps_si256(o.0),
+                ))
+            })
+        }
+        /// All ones in the lanes where `self`'s bits are greater than
+        /// `o`'s as signed 32-bit integers (AVX2), else 0.
+        #[inline(always)]
+        pub(crate) unsafe fn gt_bits(self, o: Self) -> Self {
+            Self(unsafe {
+                _mm256_castsi256_ps(_mm256_cmpgt_epi32(
+                    _mm256_castps_si256(self.0),
+                    _mm256_castps_si256(o.0),
+                ))
+            })
         }
         /// Bit `i` set where lane `i`'s sign bit is.
         #[inline(always)]

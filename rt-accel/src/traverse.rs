@@ -694,7 +694,8 @@ fn box_test_x4<const NONNEG: bool>(node: &Node, ctx: &RayCtx, t_max: f32) -> (u3
 /// arithmetic, lane for lane.
 ///
 /// # Safety
-/// The CPU must have AVX. Always inlined, into the kernels compiled with it.
+/// The CPU must have AVX (AVX2 and FMA for `FUSED`). Always inlined, into
+/// the kernels compiled with them.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn box_test_avx<const NONNEG: bool, const FUSED: bool>(
@@ -714,11 +715,27 @@ unsafe fn box_test_avx<const NONNEG: bool, const FUSED: bool>(
 /// [`crate::ray_ctx::Fused`] constants, where the robust test takes a
 /// subtraction and a multiply on the dependent chain. It admits every box
 /// the robust test admits (the proof is at `Fused`), so the hits are the
-/// same, bit for bit; no distance is NaN, so the minima and maxima pair up
-/// as a tree (two levels, not three).
+/// same, bit for bit.
+///
+/// The maxima, minima and the final compare take the distances' bits as
+/// signed integers (one cycle each on the chain where the float
+/// instructions take four; Embree's AVX2 kernels do the same). No
+/// distance is NaN, and the range's ends are made `+0` where they are
+/// `−0`, so:
+/// - the entry `t0`, a maximum with `t_min` (sign bit clear), is the float
+///   maximum: integers order floats with a clear sign bit as floats, and
+///   put every float with the sign bit set below them;
+/// - if no far distance has its sign bit set, the exit `t1` is the float
+///   minimum and `t0 > t1` compares as floats; if one has (`−0`
+///   included), `t1` is negative as an integer and the box is missed.
+///
+/// That differs from the float test only in boxes it misses with an exit
+/// at `−0`, which the robust test misses too: where that test admits a
+/// box, every fused far distance is the rounding of a positive number
+/// (`Fused`'s proof), so its sign bit is clear.
 ///
 /// # Safety
-/// The CPU must have AVX and FMA; `f` must be on (the test covers the ray
+/// The CPU must have AVX2 and FMA; `f` must be on (the test covers the ray
 /// and the BVH).
 /// Always inlined, into the kernels compiled with them.
 #[cfg(target_arch = "x86_64")]
@@ -743,17 +760,19 @@ pub(crate) unsafe fn box_lanes_fused(
             (near, far)
         }
     }
-    // SAFETY: the caller guarantees AVX and FMA.
+    // SAFETY: the caller guarantees AVX, AVX2 and FMA.
     unsafe {
         let (nx, fx) = slab(b, ctx, f, 0);
         let (ny, fy) = slab(b, ctx, f, 1);
         let (nz, fz) = slab(b, ctx, f, 2);
-        let (nxy, nzt) = (nx.max(ny), nz.max(F32x8::splat(ctx.ray.t_min)));
-        let (fxy, fzt) = (fx.min(fy), fz.min(F32x8::splat(t_max)));
-        // `max(nxy, nzt) ≤ min(fxy, fzt)` as four compares side by side
-        // (none of the values is NaN): one level shorter on the chain.
-        let entered = nxy.le(fxy).and(nxy.le(fzt)).and(nzt.le(fxy).and(nzt.le(fzt)));
-        (entered, nxy.max(nzt))
+        // The range's ends with `−0` made `+0`, so their sign bits are clear.
+        let zero = F32x8::splat(0.0);
+        let t_min = F32x8::splat(ctx.ray.t_min).max_bits(zero);
+        let t_max = F32x8::splat(t_max).max_bits(zero);
+        let t0 = nx.max_bits(ny).max_bits(nz.max_bits(t_min));
+        let t1 = fx.min_bits(fy).min_bits(fz.min_bits(t_max));
+        let missed = t0.gt_bits(t1);
+        (missed.xor(F32x8::splat_bits(u32::MAX)), t0)
     }
 }
 
@@ -761,7 +780,8 @@ pub(crate) unsafe fn box_lanes_fused(
 /// and the entry distances.
 ///
 /// # Safety
-/// The CPU must have AVX. Always inlined, into the kernels compiled with it.
+/// The CPU must have AVX (AVX2 and FMA for `FUSED`). Always inlined, into
+/// the kernels compiled with them.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) unsafe fn box_lanes_avx<const NONNEG: bool, const FUSED: bool>(
