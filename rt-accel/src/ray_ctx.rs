@@ -23,6 +23,8 @@ const ROW: u8 = size_of::<Row>() as u8;
 /// construction a third of a missed ray's cost.
 #[derive(Clone, Copy, Debug)]
 pub struct RayCtx {
+    /// The ray, with `t_min = +0` where it was `−0` (the same range: the
+    /// fused node test compares bits, and wants a clear sign bit).
     pub(crate) ray: Ray,
     /// Reciprocal direction per axis (`±∞` for `±0`).
     pub(crate) inv1: glam::Vec3A,
@@ -301,7 +303,8 @@ impl RayCtx {
     ) -> Self {
         let nonneg = ray.t_min >= 0.0;
         Self {
-            ray: *ray,
+            // `+ 0.0` makes a `−0` start `+0` (see the field).
+            ray: Ray { t_min: ray.t_min + 0.0, ..*ray },
             inv1: inv,
             inv_far: if nonneg { inv * FAR_INV_SCALE } else { inv },
             far_up: if nonneg { 1.0 } else { SLAB_FAR_SCALE },

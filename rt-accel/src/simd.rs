@@ -387,6 +387,20 @@ impl Lanes for F32x4 {
     }
 }
 
+/// Hints the CPU to start loading the cache line that holds `r`'s first
+/// byte.
+#[inline(always)]
+pub(crate) fn prefetch_line<T>(r: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        // SAFETY: SSE is in the x86-64 baseline; a prefetch never faults.
+        unsafe { _mm_prefetch::<{ _MM_HINT_T0 }>((r as *const T).cast::<i8>()) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = r;
+}
+
 /// Hints the CPU to start loading the cache lines of `bytes` bytes from
 /// `r` on (every line they touch, whatever `r`'s alignment).
 #[inline(always)]

@@ -10,7 +10,7 @@ use crate::{
     node::{ChildRef, GROUPS, Node, WIDTH},
     prim::{BestHit, Primitive, any_leaf, closest_leaf},
     ray_ctx::Fused,
-    simd::prefetch_bytes,
+    simd::{prefetch_bytes, prefetch_line},
 };
 
 /// Deepest tree accepted by builders and loaders (root = depth 1).
@@ -433,7 +433,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             // be missed only then). Closest-hit rays +2.5–3 %
             // (primary), +5–10 % (incoherent); the occlusion kernel, which
             // loads the references with the boxes, gained nothing.
-            prefetch_bytes(&node.children, 1);
+            prefetch_line(&node.children);
             // A box entered at (rounded) distance just past the best hit
             // may still hold an exact tie; widen the bound as the far
             // planes are widened.
@@ -772,10 +772,10 @@ pub(crate) unsafe fn box_lanes_fused(
         let (nx, fx) = slab(b, ctx, f, 0);
         let (ny, fy) = slab(b, ctx, f, 1);
         let (nz, fz) = slab(b, ctx, f, 2);
-        // The range's ends with `−0` made `+0`, so their sign bits are clear.
-        let zero = F32x8::splat(0.0);
-        let t_min = F32x8::splat(ctx.ray.t_min).max_bits(zero);
-        let t_max = F32x8::splat(t_max).max_bits(zero);
+        // The range's ends with their sign bits clear: `t_max` with `−0`
+        // made `+0` here, `t_min` by `RayCtx`.
+        let t_min = F32x8::splat(ctx.ray.t_min);
+        let t_max = F32x8::splat(t_max).max_bits(F32x8::splat(0.0));
         let t0 = nx.max_bits(ny).max_bits(nz.max_bits(t_min));
         let t1 = fx.min_bits(fy).min_bits(fz.min_bits(t_max));
         let missed = t0.gt_bits(t1);
