@@ -430,9 +430,10 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             // The line of the child references, which the traversal reads
             // only once the boxes are tested, fetched beside the boxes (a
             // 224-byte node's last line may hold none of them, and would
-            // be missed only then). Closest-hit rays +2.5–3 %
-            // (primary), +5–10 % (incoherent); the occlusion kernel, which
-            // loads the references with the boxes, gained nothing.
+            // be missed only then). Closest-hit rays +1.6–3 %
+            // (primary), +4–10 % (incoherent) over two interleaved runs;
+            // the occlusion kernel, which loads the references with the
+            // boxes, gained nothing.
             prefetch_line(&node.children);
             // A box entered at (rounded) distance just past the best hit
             // may still hold an exact tie; widen the bound as the far
