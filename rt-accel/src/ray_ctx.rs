@@ -425,7 +425,8 @@ pub(crate) mod tests {
     /// The fused test of one box, in scalars (`f32::mul_add` rounds once,
     /// as the kernel's multiply-add does): `(admitted, entry distance)`.
     fn fused_scalar(ctx: &RayCtx, fz: &Fused, b: &Aabb, t_max: f32) -> (bool, f32) {
-        // `+ 0.0` makes `−0` `+0`, as the lanes' integer maximum with 0 does.
+        // `+ 0.0` makes `−0` `+0`, as the kernel does (`RayCtx` for
+        // `t_min`, an integer maximum with 0 for `t_max`).
         let (mut t0, mut t1) = (ctx.ray.t_min + 0.0, t_max + 0.0);
         let mut far_sign = false;
         for a in 0..3 {
@@ -474,7 +475,7 @@ pub(crate) mod tests {
         let v3 = |v: glam::Vec3A| v.to_array().map(f32::to_bits);
         let scalars = [ctx.ray.t_min, ctx.ray.t_max, ctx.far_up, ctx.far_down].map(f32::to_bits);
         let bytes = ctx.near.iter().chain(&ctx.far).map(|&b| u32::from(b));
-        let fields = v3(ctx.ray.origin.into())
+        let mut fields = v3(ctx.ray.origin.into())
             .into_iter()
             .chain(v3(ctx.ray.direction.into()))
             .chain(scalars)
@@ -486,13 +487,8 @@ pub(crate) mod tests {
             .chain(v3(ctx.wt_org.into()))
             .chain([u32::from(f.on)])
             .chain([f.inv_near, f.off_near, f.inv_far, f.off_far].into_iter().flat_map(v3));
-        let mut out = [0; 44];
-        let mut n = 0;
-        for (o, x) in out.iter_mut().zip(fields) {
-            *o = x;
-            n += 1;
-        }
-        assert_eq!(n, 44);
+        let out = [0; 44].map(|_: u32| fields.next().expect("fewer than 44 fields"));
+        assert!(fields.next().is_none(), "more than 44 fields");
         out
     }
 
