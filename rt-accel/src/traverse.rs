@@ -457,9 +457,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                     let (near, far, t_far) =
                         if tnear[j] < tnear[i] { (cj, ci, tnear[i]) } else { (ci, cj, tnear[j]) };
                     self.prefetch(far);
-                    stack_ref[*sp].write(far);
-                    stack_t[*sp].write(t_far);
-                    *sp += 1;
+                    push(stack_ref, stack_t, sp, far, t_far);
                     *cur = near;
                     return true;
                 }
@@ -504,9 +502,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                     }
                 }
                 for a in 0..k - 1 {
-                    stack_ref[*sp].write(refs[a]);
-                    stack_t[*sp].write(ts[a]);
-                    *sp += 1;
+                    push(stack_ref, stack_t, sp, refs[a], ts[a]);
                 }
                 *cur = refs[k - 1];
                 return true;
@@ -515,9 +511,15 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         // Pop the next subtree that can still hold a closer hit.
         while *sp > 0 {
             *sp -= 1;
-            // SAFETY: entries below the pushes' count were written above
-            // (both arrays at every push).
-            let (t, r) = unsafe { (stack_t[*sp].assume_init(), stack_ref[*sp].assume_init()) };
+            debug_assert!(*sp < STACK_SIZE);
+            // SAFETY: entries below the pushes' count were written by
+            // `push` (both arrays), which kept the count within the stack.
+            let (t, r) = unsafe {
+                (
+                    stack_t.get_unchecked(*sp).assume_init(),
+                    stack_ref.get_unchecked(*sp).assume_init(),
+                )
+            };
             if t <= widen_far(best.t) {
                 *cur = r;
                 return true;
@@ -525,6 +527,30 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         }
         false
     }
+}
+
+/// Pushes `(r, t)` onto a closest-hit traversal's stack of height `sp`,
+/// unchecked: the stack is never full there. Every entry on it is a child
+/// of an inner node on the path from the root to the subtree being
+/// visited, at most `WIDTH − 1` per node (the visited child is not
+/// pushed), and that path holds at most [`MAX_DEPTH`] inner nodes
+/// (builders and `validate` reject deeper trees; `BvhRef`'s invariant). So
+/// the height stays at most `(WIDTH − 1) · MAX_DEPTH < STACK_SIZE`.
+#[inline(always)]
+fn push(
+    refs: &mut [MaybeUninit<ChildRef>; STACK_SIZE],
+    ts: &mut [MaybeUninit<f32>; STACK_SIZE],
+    sp: &mut usize,
+    r: ChildRef,
+    t: f32,
+) {
+    debug_assert!(*sp < STACK_SIZE);
+    // SAFETY: `sp < STACK_SIZE`, by the bound above.
+    unsafe {
+        refs.get_unchecked_mut(*sp).write(r);
+        ts.get_unchecked_mut(*sp).write(t);
+    }
+    *sp += 1;
 }
 
 /// Where a closest-hit traversal stands between two steps: the subtree to
