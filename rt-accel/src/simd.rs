@@ -79,6 +79,24 @@ mod imp {
             // SAFETY: SSE is in the x86-64 baseline.
             (unsafe { _mm_movemask_ps(_mm_cmpeq_ps(self.0, o.0)) }) as u32
         }
+        /// The lanes' bits or-ed.
+        #[inline(always)]
+        pub(crate) fn or_bits(self, o: Self) -> Self {
+            // SAFETY: SSE is in the x86-64 baseline.
+            Self(unsafe { _mm_or_ps(self.0, o.0) })
+        }
+        /// The lanes' bits and-ed.
+        #[inline(always)]
+        pub(crate) fn and_bits(self, o: Self) -> Self {
+            // SAFETY: SSE is in the x86-64 baseline.
+            Self(unsafe { _mm_and_ps(self.0, o.0) })
+        }
+        /// Bit `i` set where lane `i`'s sign bit is (`−0` and NaNs too).
+        #[inline(always)]
+        pub(crate) fn sign_mask(self) -> u32 {
+            // SAFETY: SSE is in the x86-64 baseline.
+            (unsafe { _mm_movemask_ps(self.0) }) as u32
+        }
     }
 }
 
@@ -145,6 +163,18 @@ mod imp {
         #[inline(always)]
         pub(crate) fn eq_mask(self, o: Self) -> u32 {
             self.mask(o, |a, b| a == b)
+        }
+        #[inline(always)]
+        pub(crate) fn or_bits(self, o: Self) -> Self {
+            self.zip(o, |a, b| f32::from_bits(a.to_bits() | b.to_bits()))
+        }
+        #[inline(always)]
+        pub(crate) fn and_bits(self, o: Self) -> Self {
+            self.zip(o, |a, b| f32::from_bits(a.to_bits() & b.to_bits()))
+        }
+        #[inline(always)]
+        pub(crate) fn sign_mask(self) -> u32 {
+            self.mask(self, |a, _| a.is_sign_negative())
         }
     }
 }
@@ -314,6 +344,18 @@ mod avx {
             (unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0)) }) as u32
         }
         #[inline(always)]
+        unsafe fn or_bits(self, o: Self) -> Self {
+            unsafe { F32x8::or(self, o) }
+        }
+        #[inline(always)]
+        unsafe fn and_bits(self, o: Self) -> Self {
+            unsafe { F32x8::and(self, o) }
+        }
+        #[inline(always)]
+        unsafe fn sign_mask(self) -> u32 {
+            unsafe { F32x8::sign_mask(self) }
+        }
+        #[inline(always)]
         fn to_lanes(self) -> [f32; 8] {
             self.to_array()
         }
@@ -342,6 +384,12 @@ pub(crate) trait Lanes: Copy {
     unsafe fn le_mask(self, o: Self) -> u32;
     unsafe fn lt_mask(self, o: Self) -> u32;
     unsafe fn eq_mask(self, o: Self) -> u32;
+    /// Bitwise or, and bitwise and, of the lanes.
+    unsafe fn or_bits(self, o: Self) -> Self;
+    /// See `or_bits`.
+    unsafe fn and_bits(self, o: Self) -> Self;
+    /// Bit `i` set where lane `i`'s sign bit is.
+    unsafe fn sign_mask(self) -> u32;
     fn to_lanes(self) -> Self::Array;
 }
 
@@ -380,6 +428,18 @@ impl Lanes for F32x4 {
     #[inline(always)]
     unsafe fn eq_mask(self, o: Self) -> u32 {
         F32x4::eq_mask(self, o)
+    }
+    #[inline(always)]
+    unsafe fn or_bits(self, o: Self) -> Self {
+        F32x4::or_bits(self, o)
+    }
+    #[inline(always)]
+    unsafe fn and_bits(self, o: Self) -> Self {
+        F32x4::and_bits(self, o)
+    }
+    #[inline(always)]
+    unsafe fn sign_mask(self) -> u32 {
+        F32x4::sign_mask(self)
     }
     #[inline(always)]
     fn to_lanes(self) -> [f32; 4] {
@@ -443,5 +503,12 @@ mod tests {
         assert_eq!(a.eq_mask(b), 0b1000);
         let s = a.add(b).mul(F32x4::splat(2.0)).sub(b).div(F32x4::splat(1.0)).to_array();
         assert_eq!(s[0], 4.0);
+        // Sign bits: `−0` has one, `+0` and the (positive) NaN do not.
+        let c = F32x4::from_array([-1.0, 2.0, -0.0, 0.0]);
+        let d = F32x4::from_array([-3.0, -4.0, 5.0, -0.0]);
+        assert_eq!(a.sign_mask(), 0b1000);
+        assert_eq!(c.or_bits(d).sign_mask(), 0b1111);
+        assert_eq!(c.and_bits(d).sign_mask(), 0b0001);
+        assert_eq!(c.and_bits(F32x4::splat(f32::from_bits(0x7fff_ffff))).to_array()[0], 1.0);
     }
 }

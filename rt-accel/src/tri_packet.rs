@@ -156,12 +156,16 @@ unsafe fn lanes<V: Verts, const EARLY: bool>(
         let w = bx.mul(ay).sub(by.mul(ax));
         let zero = splat(0.0);
         let on_edge = u.eq_mask(zero) | v.eq_mask(zero) | w.eq_mask(zero);
-        let neg = u.lt_mask(zero) | v.lt_mask(zero) | w.lt_mask(zero);
-        let pos = zero.lt_mask(u) | zero.lt_mask(v) | zero.lt_mask(w);
+        // A lane the ray passes through has edge functions of one sign:
+        // read off the sign bits, all three set or none. That is the
+        // scalar test's `u < 0 || …` and `u > 0 || …` wherever those
+        // decide: lanes with a zero function are the scalar test's
+        // (`on_edge`), and a NaN one makes `det` NaN, rejected below.
+        let any_neg = u.or_bits(v).or_bits(w).sign_mask();
+        let all_neg = u.and_bits(v).and_bits(w).sign_mask();
+        let one_sign = all_neg | !any_neg;
         let all = <V::L as Lanes>::ALL;
-        // A lane the ray passes through has edge functions of one sign
-        // (exactly one of `neg`, `pos`; neither for unused NaN lanes).
-        if EARLY && ((neg ^ pos) | on_edge) & all == 0 {
+        if EARLY && (one_sign | on_edge) & all == 0 {
             return (0, 0, zero.to_lanes());
         }
         let det = u.add(v).add(w);
@@ -172,7 +176,7 @@ unsafe fn lanes<V: Verts, const EARLY: bool>(
         let in_range = splat(ctx.ray.t_min).le_mask(t) & t.le_mask(splat(t_max)) & t.lt_mask(inf);
         // As the scalar test: an overflowed `det` is no hit.
         let finite = det.lt_mask(inf) & splat(f32::NEG_INFINITY).lt_mask(det);
-        let ok = !(neg & pos) & !det.eq_mask(zero) & finite & in_range & !on_edge & all;
+        let ok = one_sign & !det.eq_mask(zero) & finite & in_range & !on_edge & all;
         (ok, on_edge & all, t.to_lanes())
     }
 }
