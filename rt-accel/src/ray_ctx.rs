@@ -39,13 +39,13 @@ pub struct RayCtx {
     pub(crate) far_up: f32,
     /// See `far_up`.
     pub(crate) far_down: f32,
-    /// Byte offset in `Node::bounds` of the row holding the near plane
-    /// per axis (row `2·axis + sign bit`, 32 bytes a row): an offset, not
-    /// a row, so a node test adds it to the node's address without a
-    /// shift (six fewer instructions a node).
-    pub(crate) near: [u8; 3],
-    /// Byte offset of the row holding the far plane per axis.
-    pub(crate) far: [u8; 3],
+    /// Byte offsets in `Node::bounds` of the rows holding the near plane
+    /// per axis (entries 0–2: row `2·axis + sign bit`, 32 bytes a row)
+    /// and the far plane per axis (entries 4–6); entries 3 and 7 are 0.
+    /// Offsets, not rows, so a node test adds them to the node's address
+    /// without a shift (six fewer instructions a node); eight bytes, so
+    /// the setup copies them in one load and one store.
+    pub(crate) rows: [u8; 8],
     /// Watertight shear constants for triangles.
     pub(crate) wt: WatertightRay,
     /// Origin permuted to `[kx, ky, kz]`.
@@ -69,18 +69,19 @@ pub struct RayCtx {
 /// + off_far` (exact products and sums, one rounding). Rounding is
 /// monotone, so bounds on the exact `X` and `Y` carry over:
 /// - `inv_near = fl(inv·(1 − 8u))`, so `0 < inv_near/inv < 1 − 6u`.
-///   With `p = fl(o·inv_near)`, `off_near = −fl(p + 8u·|p|)`, moved out
-///   to `−2⁻¹¹⁹` where it is below `2⁻¹²⁰` in magnitude. In the normal
-///   range `|p − o·inv_near| ≤ u·|o·inv_near|`, which the `7u·|p|` left
-///   after rounding covers; below it the floor does. So `off_near ≤
-///   −o·inv_near` and `X ≤ (b − o)·inv_near`. Where `(b − o)·inv > 0`,
+///   With `p = fl(o·inv_near)`, `off_near = fl(−fl(p + 8u·|p|) − 2⁻¹¹⁹)`
+///   (the floor `2⁻¹¹⁹`, a subtraction of a positive number, can only
+///   lower it). In the normal range `|p − o·inv_near| ≤ u·|o·inv_near|`,
+///   which the `7u·|p|` left after rounding covers; below it the floor
+///   does. So `off_near ≤ −o·inv_near` and `X ≤ (b − o)·inv_near`. Where `(b − o)·inv > 0`,
 ///   `X < (b − o)·inv·(1 − 6u) < fl(b − o)·inv` (a subtraction rounds by
 ///   at most `u` relative, and is exact among subnormals): `n* ≤ n`.
 ///   Elsewhere `X ≤ 0`, so `n* ≤ 0 ≤ t_min`. Either way `max(n*, t_min) ≤
 ///   max(n, t_min)`.
 /// - `inv_far = fl(inv_f·(1 + 8u))`, so `inv_far/inv_f > 1 + 6u`. With `q
-///   = fl(o·inv_far)`, `off_far = fl(8u·|q| − q)`, moved out to `2⁻¹¹⁹`
-///   where it is below `2⁻¹²⁰`: as above, `off_far ≥ −o·inv_far + 2⁻¹⁴⁸`,
+///   = fl(o·inv_far)`, `off_far = fl(fl(8u·|q| − q) + 2⁻¹¹⁹)`, which the
+///   floor can only raise: as above, `off_far ≥ −o·inv_far + 2⁻¹⁴⁸` (the
+///   floor covers it where `q` is subnormal or 0),
 ///   so `Y ≥ (b' − o)·inv_far + 2⁻¹⁴⁸`. Where `(b' − o)·inv_f > 0`, `Y >
 ///   (b' − o)·inv_f·(1 + 6u) > fl(b' − o)·inv_f`: `f* ≥ f`. Elsewhere `f ≤
 ///   0`. If `f < 0`, the robust test rejects the box (its entry is at
@@ -93,9 +94,13 @@ pub struct RayCtx {
 /// ([`rt_core::Aabb::admits_hit`]) accepts: exactly a brute-force loop's
 /// hits. It admits a little more: boxes a ray misses by a few ulps of its
 /// origin's coordinates (or, for geometry below `2⁻¹⁰⁰`, by the floors).
-/// The floors keep the offsets normal: a subnormal operand costs an Intel
-/// core's multiply-add a microcode assist (primary rays from an eye at `x
-/// = 0` ran 2.6× slower).
+/// The floors keep the offsets out of the subnormal range (an offset
+/// cancels to a subnormal only where `fl(p + 8u·|p|)` or `fl(8u·|q| − q)`
+/// lies within `2⁻¹²⁶` of `∓2⁻¹¹⁹`, an origin coordinate of about `2⁻¹¹⁹`
+/// ray lengths): a subnormal operand costs an Intel core's multiply-add a
+/// microcode assist (primary rays from an eye at `x = 0` ran 2.6× slower
+/// without floors). One addition each, where replacing the small offsets
+/// by the floor took a compare and a select.
 ///
 /// The bounds need every value above to be finite and the reciprocals
 /// normal, and `b − o` not to overflow: the ray has `t_min ≥ 0`, `|o| ≤
@@ -136,18 +141,18 @@ static PERM: [[i32; 4]; 8] = [
     [0, 1, 2, 3],
 ];
 
-/// `RayCtx::near` and `RayCtx::far` by the direction's sign bits (bit
-/// `a` set: axis `a` negative): the near plane's row is `2·a + 1` for a
-/// negative direction, `2·a` otherwise.
-static NEAR_FAR: [([u8; 3], [u8; 3]); 8] = {
-    let mut t = [([0; 3], [0; 3]); 8];
+/// `RayCtx::rows` by the direction's sign bits (bit `a` set: axis `a`
+/// negative): the near plane's row is `2·a + 1` for a negative direction,
+/// `2·a` otherwise, and the far plane's the other one.
+static ROWS: [[u8; 8]; 8] = {
+    let mut t = [[0; 8]; 8];
     let mut m = 0;
     while m < 8 {
         let mut a = 0;
         while a < 3 {
             let neg = (m >> a & 1) as u8;
-            t[m].0[a] = ROW * (2 * a as u8 + neg);
-            t[m].1[a] = ROW * (2 * a as u8 + 1 - neg);
+            t[m][a] = ROW * (2 * a as u8 + neg);
+            t[m][4 + a] = ROW * (2 * a as u8 + 1 - neg);
             a += 1;
         }
         m += 1;
@@ -174,16 +179,13 @@ impl Fused {
     fn from_parts(o: glam::Vec3A, inv: glam::Vec3A, inv_f: glam::Vec3A, enable: bool) -> Self {
         use glam::Vec3A;
         const EIGHT_U: f32 = 8.0 * (f32::EPSILON * 0.5);
-        // 2⁻¹²⁰: offsets smaller than this move out to twice it.
-        const TINY: f32 = 1.0 / (1u128 << 120) as f32;
+        // 2⁻¹¹⁹: the offsets' floor, moved outward by it.
+        const FLOOR: f32 = 1.0 / (1u128 << 119) as f32;
         let inv_near = inv * (1.0 - EIGHT_U);
         let inv_far = inv_f * (1.0 + EIGHT_U);
         let (p, q) = (o * inv_near, o * inv_far);
-        let clamp = |v: Vec3A, to: f32| {
-            Vec3A::select(v.abs().cmplt(Vec3A::splat(TINY)), Vec3A::splat(to), v)
-        };
-        let off_near = clamp(-(p + p.abs() * EIGHT_U), -2.0 * TINY);
-        let off_far = clamp(q.abs() * EIGHT_U - q, 2.0 * TINY);
+        let off_near = -(p + p.abs() * EIGHT_U) - FLOOR;
+        let off_far = (q.abs() * EIGHT_U - q) + FLOOR;
         let a = inv.abs();
         let ok = o.abs().cmple(Vec3A::splat(FUSED_RANGE))
             & a.cmpge(Vec3A::splat(2.0 * f32::MIN_POSITIVE))
@@ -234,11 +236,11 @@ impl RayCtx {
     #[inline(always)]
     pub(crate) unsafe fn new_fused_avx(ray: &Ray, tree_in_range: bool) -> Option<(Self, Fused)> {
         use core::arch::x86_64::{
-            _CMP_LT_OQ, _CMP_NEQ_UQ, _mm_and_ps, _mm_blend_ps, _mm_castsi128_ps, _mm_div_ps,
-            _mm_loadu_ps, _mm_loadu_si128, _mm_movemask_ps, _mm_mul_ps, _mm_permute_ps,
-            _mm_permutevar_ps, _mm_set1_epi32, _mm_set1_ps, _mm256_and_ps, _mm256_castsi256_ps,
-            _mm256_cmp_ps, _mm256_loadu_ps, _mm256_movemask_ps, _mm256_set1_epi32, _mm256_set1_ps,
-            _mm256_setzero_ps,
+            __m256, _CMP_LT_OQ, _CMP_NEQ_UQ, _mm_and_ps, _mm_blend_ps, _mm_castsi128_ps,
+            _mm_div_ps, _mm_loadu_ps, _mm_loadu_si128, _mm_movemask_ps, _mm_mul_ps, _mm_permute_ps,
+            _mm_permutevar_ps, _mm_set1_epi32, _mm_set1_ps, _mm256_add_ps, _mm256_and_ps,
+            _mm256_blend_ps, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_loadu_ps,
+            _mm256_movemask_ps, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_ps,
         };
         const { assert!(size_of::<Ray>() == 32 && align_of::<Ray>() == 4) };
         // SAFETY: the caller guarantees AVX. `Ray` is `repr(C)`, eight
@@ -281,36 +283,40 @@ impl RayCtx {
             };
             let wt_org = glam::Vec3A::from(_mm_permutevar_ps(o, ctrl)).into();
             let inv = glam::Vec3A::from(_mm_div_ps(_mm_set1_ps(1.0), d));
-            let (near, far) = NEAR_FAR[neg];
-            let ctx = Self::assemble(ray, inv, near, far, wt, wt_org);
+            // The ray whole, with `t_min + 0` (lane 6): one store, where
+            // field by field it took eight moves.
+            let fixed =
+                _mm256_blend_ps::<0b0100_0000>(all, _mm256_add_ps(all, _mm256_setzero_ps()));
+            // SAFETY: `Ray` is eight `f32`s (checked above), any bits are
+            // a valid `f32`.
+            let fixed = core::mem::transmute::<__m256, Ray>(fixed);
+            let ctx = Self::assemble(fixed, inv, ROWS[neg], wt, wt_org);
             let enable = ray.t_min >= 0.0 && tree_in_range;
             let fused = Fused::from_parts(glam::Vec3A::from(o), inv, ctx.inv_far, enable);
             Some((ctx, fused))
         }
     }
 
-    /// The context of a valid `ray` from what its constructors compute:
-    /// the reciprocal direction, the near and far row offsets and the
+    /// The context of a valid `ray` (its `t_min` made `+0` where it was
+    /// `−0`, see the field) from what its constructors compute: the
+    /// reciprocal direction, the near and far row offsets and the
     /// watertight constants.
     #[inline(always)]
     fn assemble(
-        ray: &Ray,
+        ray: Ray,
         inv: glam::Vec3A,
-        near: [u8; 3],
-        far: [u8; 3],
+        rows: [u8; 8],
         wt: WatertightRay,
         wt_org: glam::Vec3,
     ) -> Self {
         let nonneg = ray.t_min >= 0.0;
         Self {
-            // `+ 0.0` makes a `−0` start `+0` (see the field).
-            ray: Ray { t_min: ray.t_min + 0.0, ..*ray },
+            ray,
             inv1: inv,
             inv_far: if nonneg { inv * FAR_INV_SCALE } else { inv },
             far_up: if nonneg { 1.0 } else { SLAB_FAR_SCALE },
             far_down: if nonneg { 1.0 } else { SLAB_FAR_SCALE_NEG },
-            near,
-            far,
+            rows,
             wt,
             wt_org,
         }
@@ -323,7 +329,7 @@ impl RayCtx {
         }
         let o = ray.origin;
         let d = ray.direction;
-        let (near, far) = NEAR_FAR[d.is_negative_bitmask() as usize & 7];
+        let rows = ROWS[d.is_negative_bitmask() as usize & 7];
         let wt = WatertightRay::new(ray);
         let [kx, ky, kz] = wt.axes;
         let inv = glam::Vec3A::from(d).recip();
@@ -334,7 +340,8 @@ impl RayCtx {
             let o = o.to_array();
             glam::Vec3::new(o[kx], o[ky], o[kz])
         };
-        let ctx = Self::assemble(ray, inv, near, far, wt, wt_org);
+        // `+ 0.0` makes a `−0` start `+0` (see the field).
+        let ctx = Self::assemble(Ray { t_min: ray.t_min + 0.0, ..*ray }, inv, rows, wt, wt_org);
         let fused = if FUSED {
             Fused::from_parts(o.into(), inv, ctx.inv_far, ray.t_min >= 0.0 && tree_in_range)
         } else {
@@ -390,12 +397,13 @@ impl RayCtx {
     /// The near and far plane rows of `bounds` (a node's) for axis `a`.
     #[inline(always)]
     pub(crate) fn planes<'b>(&self, bounds: &'b Rows, a: usize) -> (&'b Row, &'b Row) {
-        let (near, far) = (usize::from(self.near[a]), usize::from(self.far[a]));
+        let (near, far) = (usize::from(self.rows[a]), usize::from(self.rows[4 + a]));
         debug_assert!(near % size_of::<Row>() == 0 && near < size_of::<Rows>());
         debug_assert!(far % size_of::<Row>() == 0 && far < size_of::<Rows>());
-        // SAFETY: `RayCtx::build`, the only constructor, sets every `near`
-        // and `far` entry to `ROW·(2·axis)` or `ROW·(2·axis + 1)` with
-        // `axis < 3`: the offset of one of the six rows.
+        // SAFETY: the constructors set entries 0–2 and 4–6 of `rows`
+        // from `ROWS`, whose entries there are `ROW·(2·axis)` or
+        // `ROW·(2·axis + 1)` with `axis < 3`: the offset of one of the six
+        // rows.
         unsafe {
             let rows = core::ptr::from_ref(bounds);
             (&*rows.byte_add(near).cast::<Row>(), &*rows.byte_add(far).cast::<Row>())
@@ -470,11 +478,11 @@ pub(crate) mod tests {
 
     /// Every field of a context and its fused constants, as bits (an
     /// array: the crate's tests also build without `alloc`).
-    fn ctx_bits(c: &(RayCtx, Fused)) -> [u32; 44] {
+    fn ctx_bits(c: &(RayCtx, Fused)) -> [u32; 46] {
         let (ctx, f) = c;
         let v3 = |v: glam::Vec3A| v.to_array().map(f32::to_bits);
         let scalars = [ctx.ray.t_min, ctx.ray.t_max, ctx.far_up, ctx.far_down].map(f32::to_bits);
-        let bytes = ctx.near.iter().chain(&ctx.far).map(|&b| u32::from(b));
+        let bytes = ctx.rows.map(u32::from);
         let mut fields = v3(ctx.ray.origin.into())
             .into_iter()
             .chain(v3(ctx.ray.direction.into()))
@@ -487,8 +495,8 @@ pub(crate) mod tests {
             .chain(v3(ctx.wt_org.into()))
             .chain([u32::from(f.on)])
             .chain([f.inv_near, f.off_near, f.inv_far, f.off_far].into_iter().flat_map(v3));
-        let out = [0; 44].map(|_: u32| fields.next().expect("fewer than 44 fields"));
-        assert!(fields.next().is_none(), "more than 44 fields");
+        let out = [0; 46].map(|_: u32| fields.next().expect("fewer than 46 fields"));
+        assert!(fields.next().is_none(), "more than 46 fields");
         out
     }
 
