@@ -199,6 +199,11 @@ fn any_lane(
         }
         edge |= 1 << l;
     }
+    if edge == 0 {
+        // Most leaves: no ray copy (made before the loop, it was made at
+        // every leaf, 45 instructions a shadow ray).
+        return false;
+    }
     let r = Ray { t_max, ..ctx.ray };
     while edge != 0 {
         let l = edge.trailing_zeros() as usize;
