@@ -188,8 +188,14 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
             Isa::Avx2 => unsafe { self.occluded_avx2(ray, stack) },
-            _ => self.occluded_kernel::<false>(ray, stack),
+            _ => self.occluded_portable(ray, stack),
         }
+    }
+
+    /// The 4-wide kernel, out of line (see `closest_portable`).
+    #[inline(never)]
+    fn occluded_portable(&self, ray: &Ray, stack: &mut TraversalStack) -> bool {
+        self.occluded_kernel::<false>(ray, stack)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -343,8 +349,16 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
             Isa::Avx2 => unsafe { self.closest_avx2(ray, stack) },
-            _ => self.closest_kernel::<false>(ray, &mut TraversalStats::default(), stack),
+            _ => self.closest_portable(ray, stack),
         }
+    }
+
+    /// The 4-wide kernel, out of line as the AVX ones are: inlined into
+    /// the dispatch, its stack frame (the registers it saves, 840 bytes)
+    /// was set up on every query, whichever kernel ran.
+    #[inline(never)]
+    fn closest_portable(&self, ray: &Ray, stack: &mut TraversalStack) -> Option<BestHit> {
+        self.closest_kernel::<false>(ray, &mut TraversalStats::default(), stack)
     }
 
     #[cfg(target_arch = "x86_64")]
