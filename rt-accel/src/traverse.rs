@@ -463,6 +463,14 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 let rest = mask & (mask - 1);
                 if rest == 0 {
                     *cur = node.children[i];
+                    // Fetched here, as Embree fetches the child it visits
+                    // (likely why it helps: the next step branches on
+                    // what the child is, which mispredicts for rays of
+                    // random direction, and its loads would wait for the
+                    // recovery): incoherent rays +3.5–5 % (icosphere) and
+                    // +2.3 % (terrain) against Embree, primary rays
+                    // 0.5–1 % slower (Zen 4, 10–15 interleaved rounds).
+                    self.prefetch(*cur);
                     return true;
                 }
                 let j = rest.trailing_zeros() as usize;
@@ -470,6 +478,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                     let (ci, cj) = (node.children[i], node.children[j]);
                     let (near, far, t_far) =
                         if tnear[j] < tnear[i] { (cj, ci, tnear[i]) } else { (ci, cj, tnear[j]) };
+                    self.prefetch(near);
                     self.prefetch(far);
                     push(stack_ref, stack_t, sp, far, t_far);
                     *cur = near;
