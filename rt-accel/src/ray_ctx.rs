@@ -570,11 +570,6 @@ pub(crate) mod tests {
         assert!(valid > 100_000 && on > 5_000, "{valid} {on}");
     }
 
-    /// The fused node test admits every box the robust test admits, at
-    /// an entry distance no later, over rays and boxes of every scale
-    /// (subnormal through `2¹²⁶`), grazing rays through box edges and
-    /// corners, and origins on box planes; and the AVX kernel's lanes
-    /// equal the scalar model, bit for bit.
     /// The leaves' box check equals rt-core's `Aabb::admits_hit` on
     /// every ray and box: directions of both signs on every axis (signed
     /// zeros included), `t_min` below and above 0, boxes of any magnitude
@@ -626,6 +621,11 @@ pub(crate) mod tests {
         assert!(admitted > 10_000 && refused > 10_000, "{admitted} admitted, {refused} refused");
     }
 
+    /// The fused node test admits every box the robust test admits, at
+    /// an entry distance no later, over rays and boxes of every scale
+    /// (subnormal through `2¹²⁶`), grazing rays through box edges and
+    /// corners, and origins on box planes; and the AVX kernel's lanes
+    /// equal the scalar model, bit for bit.
     #[test]
     fn fused_node_test_admits_every_box_the_robust_test_admits() {
         let mut g = Bits(0x9e37_79b9_7f4a_7c15);
