@@ -157,60 +157,65 @@ impl<P: Primitive> BvhRef<'_, P> {
     }
 
     /// The stream kernel of [`BvhRef::occluded_stream`] (non-empty BVH):
-    /// groups of up to [`GROUP`] consecutive valid rays.
+    /// groups of up to [`GROUP`] consecutive rays.
     #[inline(always)]
     fn occluded_stream_kernel<const AVX: bool>(
         &self,
         rays: &[Ray],
         out: &mut dyn FnMut(usize, bool),
     ) {
-        // Filler for the unused end of the group arrays (never read).
-        let Some(filler) = RayCtx::new(&Ray::new(glam::Vec3::ZERO, glam::Vec3::X)) else {
-            return;
-        };
-        let mut ctxs = [filler; GROUP];
+        let Some(mut group) = Group::new() else { return };
         let mut index = [0usize; GROUP];
-        let mut stack = GroupStack::new();
+        for start in (0..rays.len()).step_by(GROUP) {
+            let n = GROUP.min(rays.len() - start);
+            index.iter_mut().zip(start..).for_each(|(i, s)| *i = s);
+            self.occluded_rays::<AVX>(rays, &index[..n], &mut group, out);
+        }
+    }
+
+    /// Answers `rays[i]` for every `i` of `index` (at most [`GROUP`]): the
+    /// invalid rays miss, the others walk the tree as one group with the
+    /// fastest box test that holds for all of them.
+    #[inline(always)]
+    fn occluded_rays<const AVX: bool>(
+        &self,
+        rays: &[Ray],
+        index: &[usize],
+        g: &mut Group,
+        out: &mut dyn FnMut(usize, bool),
+    ) {
         let mut n = 0;
-        // Whether every ray of the group has `t_min ≥ 0` (shadow and AO
-        // rays do): then the whole group takes the shorter box test.
-        let mut nonneg = true;
-        for (i, ray) in rays.iter().enumerate() {
-            let Some(ctx) = RayCtx::new(ray) else {
+        // Whether every ray has `t_min ≥ 0` (shadow and AO rays do): then
+        // the shorter box test applies to each (`box_test`); whether the
+        // fused test covers every ray (only on the AVX kernels, see
+        // `ray_constants`).
+        let (mut nonneg, mut fused) = (true, true);
+        for &i in index {
+            let Some((ctx, fz)) = self.ray_constants::<AVX>(&rays[i]) else {
                 out(i, false);
                 continue;
             };
             nonneg &= ctx.ray.t_min >= 0.0;
-            ctxs[n] = ctx;
-            index[n] = i;
+            fused &= fz.on;
+            (g.ctxs[n], g.fzs[n], g.index[n]) = (ctx, fz, i);
             n += 1;
-            if n == GROUP {
-                let hit = self.occluded_group_any::<AVX>(&ctxs, nonneg, &mut stack);
-                (0..GROUP).for_each(|r| out(index[r], hit >> r & 1 != 0));
-                n = 0;
-                nonneg = true;
-            }
         }
-        if n > 0 {
-            let hit = self.occluded_group_any::<AVX>(&ctxs[..n], nonneg, &mut stack);
-            (0..n).for_each(|r| out(index[r], hit >> r & 1 != 0));
+        if n == 0 {
+            return;
         }
-    }
-
-    /// [`Self::occluded_group`] with the box test `nonneg` picks (true
-    /// only if every ray has `t_min ≥ 0`, see `box_test`).
-    #[inline(always)]
-    fn occluded_group_any<const AVX: bool>(
-        &self,
-        ctxs: &[RayCtx],
-        nonneg: bool,
-        stack: &mut GroupStack,
-    ) -> u32 {
-        if nonneg {
-            self.occluded_group::<AVX, true>(ctxs, stack)
+        let (ctxs, fzs, stack) = (&g.ctxs[..n], &g.fzs[..n], &mut g.stack);
+        // The rays of a group share their octant, hence their plane rows,
+        // which `group_box_fused` loads from the first ray's (checked).
+        let hit = if fused && ctxs.iter().all(|c| c.rows == ctxs[0].rows) {
+            self.occluded_group::<AVX, true, true, true>(ctxs, fzs, stack)
+        } else if fused {
+            self.occluded_group::<AVX, true, true, false>(ctxs, fzs, stack)
+        } else if nonneg {
+            self.occluded_group::<AVX, true, false, false>(ctxs, fzs, stack)
         } else {
-            self.occluded_group::<AVX, false>(ctxs, stack)
-        }
+            self.occluded_group::<AVX, false, false, false>(ctxs, fzs, stack)
+        };
+        (0..n).for_each(|r| out(g.index[r], hit >> r & 1 != 0));
     }
 
     /// Whether each ray of the group is occluded (bit `r` for `ctxs[r]`),
@@ -221,9 +226,15 @@ impl<P: Primitive> BvhRef<'_, P> {
     /// same answer. A subtree is pushed with the rays that entered it; a
     /// ray found occluded drops out of every pending subtree.
     #[inline(always)]
-    fn occluded_group<const AVX: bool, const NONNEG: bool>(
+    fn occluded_group<
+        const AVX: bool,
+        const NONNEG: bool,
+        const FUSED: bool,
+        const SHARED: bool,
+    >(
         &self,
         ctxs: &[RayCtx],
+        fzs: &[Fused],
         stack: &mut GroupStack,
     ) -> u32 {
         let all = if ctxs.len() >= 32 { u32::MAX } else { (1u32 << ctxs.len()) - 1 };
@@ -251,7 +262,8 @@ impl<P: Primitive> BvhRef<'_, P> {
                 } else {
                     let node = self.node(cur);
                     // The rays entering each child.
-                    let child = group_box_test::<AVX, NONNEG>(node, ctxs, active);
+                    let child =
+                        group_box_test::<AVX, NONNEG, FUSED, SHARED>(node, ctxs, fzs, active);
                     sp = push_group::<AVX>(&mut stack.0, sp, node, &child);
                 }
             }
@@ -265,21 +277,30 @@ impl<P: Primitive> BvhRef<'_, P> {
 }
 
 /// Which of the rays in `active` (bits of `ctxs`) enter each child of
-/// `node`, each ray tested with the single-ray occlusion test. The AVX
-/// kernels gather the rays' bits with two vector operations per ray; the
-/// 4-wide one bit by bit. Branch-free: which children a ray enters is
-/// unpredictable. `NONNEG`: every ray of the group has `t_min ≥ 0`, so
-/// the shorter box test applies to each (`box_test`): shadow and AO
-/// streams +2–5 %.
+/// `node`, each ray tested with the single-ray occlusion test: the
+/// fused one with the plane rows loaded once for the group (`FUSED`: the
+/// test covers every ray, and all have the same octant, see
+/// `group_box_fused`), else the robust one, short where every ray has
+/// `t_min ≥ 0` (`NONNEG`, see `box_test`: shadow and AO streams +2–5 %).
+/// The AVX kernels gather the rays' bits with two vector operations per
+/// ray; the 4-wide one bit by bit. Branch-free: which children a ray
+/// enters is unpredictable.
 #[inline(always)]
-fn group_box_test<const AVX: bool, const NONNEG: bool>(
+fn group_box_test<const AVX: bool, const NONNEG: bool, const FUSED: bool, const SHARED: bool>(
     node: &Node,
     ctxs: &[RayCtx],
+    fzs: &[Fused],
     active: u32,
 ) -> [u32; WIDTH] {
     #[cfg(target_arch = "x86_64")]
     if AVX {
         use crate::{simd::F32x8, traverse::box_lanes_avx};
+        if FUSED {
+            // SAFETY: `AVX` kernels run only where the CPU has AVX2 and
+            // FMA (see `box_test`); `FUSED` is set only where every `fzs` is
+            // on and every ray has the rows of `ctxs[0]` (the caller's `FUSED`).
+            return unsafe { group_box_fused::<SHARED>(node, ctxs, fzs, active) };
+        }
         // SAFETY: `AVX` kernels run only where the CPU has AVX2 (see
         // `box_test`).
         return unsafe {
@@ -301,6 +322,7 @@ fn group_box_test<const AVX: bool, const NONNEG: bool>(
             acc.to_bits()
         };
     }
+    let _ = fzs;
     let mut child = [0u32; WIDTH];
     let mut m = active;
     while m != 0 {
@@ -317,8 +339,70 @@ fn group_box_test<const AVX: bool, const NONNEG: bool>(
     child
 }
 
+/// [`group_box_test`] with the fused test, as the single-ray occlusion
+/// kernel runs it (the same subtrees, so the same answers), the six plane
+/// rows loaded once for the group: its rays share their direction signs,
+/// so they test the same rows, and each ray's test is then six
+/// multiply-adds on registers and the compares.
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA; every ray of `ctxs` must have the
+/// fused test on in `fzs` and the rows (`RayCtx::rows`) of `ctxs[0]`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn group_box_fused<const SHARED: bool>(
+    node: &Node,
+    ctxs: &[RayCtx],
+    fzs: &[Fused],
+    active: u32,
+) -> [u32; WIDTH] {
+    use crate::{
+        simd::F32x8,
+        traverse::{fused_lanes, fused_rows},
+    };
+    // SAFETY: the caller guarantees AVX2, FMA and the fused test's
+    // constants; `ctxs` is not empty (the group has a ray).
+    unsafe {
+        let shared = fused_rows(&node.bounds, &ctxs[0]);
+        let mut acc = F32x8::splat_bits(0);
+        let mut m = active;
+        while m != 0 {
+            let r = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let ctx = &ctxs[r];
+            // Widened as in the single-ray occlusion test.
+            let rows = if SHARED { shared } else { fused_rows(&node.bounds, ctx) };
+            let (entered, _) = fused_lanes(&rows, ctx, &fzs[r], widen_far(ctx.ray.t_max));
+            acc = acc.or(entered.and(F32x8::splat_bits(1 << r)));
+        }
+        acc.to_bits()
+    }
+}
+
 /// Rays an occlusion stream walks the tree with together (bits of a `u32`).
 pub const GROUP: usize = 32;
+
+/// A group's rays (their constants and indices in the stream) and its
+/// stack, made once a stream and reused by every group.
+struct Group {
+    ctxs: [RayCtx; GROUP],
+    fzs: [Fused; GROUP],
+    index: [usize; GROUP],
+    stack: GroupStack,
+}
+
+impl Group {
+    fn new() -> Option<Self> {
+        // Filler for the unused end of the arrays (never read).
+        let filler = RayCtx::new(&Ray::new(glam::Vec3::ZERO, glam::Vec3::X))?;
+        Some(Self {
+            ctxs: [filler; GROUP],
+            fzs: [Fused::OFF; GROUP],
+            index: [0; GROUP],
+            stack: GroupStack::new(),
+        })
+    }
+}
 
 /// The pending subtrees of a group and the rays that entered each. Each
 /// level leaves at most `WIDTH − 1` siblings pending and pushes at most

@@ -241,7 +241,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     /// on the AVX kernels (on where it covers the ray and this BVH), off
     /// on the 4-wide ones; `None` for an invalid ray.
     #[inline(always)]
-    fn ray_constants<const AVX: bool>(&self, ray: &Ray) -> Option<(RayCtx, Fused)> {
+    pub(crate) fn ray_constants<const AVX: bool>(&self, ray: &Ray) -> Option<(RayCtx, Fused)> {
         #[cfg(target_arch = "x86_64")]
         if AVX {
             // SAFETY: `AVX` kernels run only inside the functions compiled
@@ -926,25 +926,59 @@ pub(crate) unsafe fn box_lanes_fused(
     f: &Fused,
     t_max: f32,
 ) -> (crate::simd::F32x8, crate::simd::F32x8) {
+    // SAFETY: the caller guarantees AVX, AVX2 and FMA, and `f`.
+    unsafe { fused_lanes(&fused_rows(b, ctx), ctx, f, t_max) }
+}
+
+/// The six plane rows of `b` that [`box_lanes_fused`] tests for a ray with
+/// `ctx`'s direction signs, as lanes: the near and far rows of x, y, z.
+/// Rays of one direction octant test the same rows, so an occlusion
+/// stream group of such rays loads them once a node.
+///
+/// # Safety
+/// The CPU must have AVX. Always inlined.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) unsafe fn fused_rows(b: &[[[f32; 4]; 2]; 6], ctx: &RayCtx) -> [crate::simd::F32x8; 6] {
+    use crate::simd::F32x8;
+    let (nx, fx) = ctx.planes(b, 0);
+    let (ny, fy) = ctx.planes(b, 1);
+    let (nz, fz) = ctx.planes(b, 2);
+    [nx, fx, ny, fy, nz, fz].map(|r| F32x8::from_groups(*r))
+}
+
+/// [`box_lanes_fused`] on rows loaded already ([`fused_rows`], for a ray
+/// of `ctx`'s octant).
+///
+/// # Safety
+/// As [`box_lanes_fused`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) unsafe fn fused_lanes(
+    rows: &[crate::simd::F32x8; 6],
+    ctx: &RayCtx,
+    f: &Fused,
+    t_max: f32,
+) -> (crate::simd::F32x8, crate::simd::F32x8) {
     use crate::simd::{F32x8, Lanes as _};
     debug_assert!(f.on);
+    // A function, not a closure (see `box_lanes_avx`).
     #[inline(always)]
-    unsafe fn slab(b: &[[[f32; 4]; 2]; 6], ctx: &RayCtx, f: &Fused, a: usize) -> (F32x8, F32x8) {
+    unsafe fn slab(rows: &[F32x8; 6], f: &Fused, a: usize) -> (F32x8, F32x8) {
         // SAFETY: the caller guarantees AVX and FMA.
         unsafe {
-            let (near, far) = ctx.planes(b, a);
-            let near = F32x8::from_groups(*near)
-                .mul_add(F32x8::splat(f.inv_near[a]), F32x8::splat(f.off_near[a]));
-            let far = F32x8::from_groups(*far)
-                .mul_add(F32x8::splat(f.inv_far[a]), F32x8::splat(f.off_far[a]));
+            let near =
+                rows[2 * a].mul_add(F32x8::splat(f.inv_near[a]), F32x8::splat(f.off_near[a]));
+            let far =
+                rows[2 * a + 1].mul_add(F32x8::splat(f.inv_far[a]), F32x8::splat(f.off_far[a]));
             (near, far)
         }
     }
     // SAFETY: the caller guarantees AVX, AVX2 and FMA.
     unsafe {
-        let (nx, fx) = slab(b, ctx, f, 0);
-        let (ny, fy) = slab(b, ctx, f, 1);
-        let (nz, fz) = slab(b, ctx, f, 2);
+        let (nx, fx) = slab(rows, f, 0);
+        let (ny, fy) = slab(rows, f, 1);
+        let (nz, fz) = slab(rows, f, 2);
         // The range's ends with their sign bits clear: `t_max` with `−0`
         // made `+0` here, `t_min` by `RayCtx`.
         let t_min = F32x8::splat(ctx.ray.t_min);

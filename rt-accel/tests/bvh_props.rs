@@ -199,6 +199,50 @@ proptest! {
         }
     }
 
+    /// Occlusion streams of shadow-like rays (one direction, origins
+    /// spread, `t_min ≥ 0`: the groups whose rays share an octant take the
+    /// fused node test with the plane rows loaded once), some with a
+    /// component's sign flipped (groups of mixed octants), some with
+    /// `t_min < 0`, some from past the fused test's range, some invalid:
+    /// every answer is brute force's, on every kernel.
+    #[test]
+    fn coherent_streams_answer_as_brute_force(
+        (pos, idx) in soup(),
+        d in vec3(1.0).prop_filter("zero dir", |d| d.length_squared() > 1e-4),
+        rays in prop::collection::vec((vec3(14.0), 0.0f32..3.0, 0.5f32..30.0, 0u32..200), 1..150),
+        p in quality(),
+    ) {
+        let bvh = build_triangles(&pos, &idx, &p).unwrap();
+        let rays: Vec<Ray> = rays
+            .into_iter()
+            .map(|(o, t_min, t_max, kind)| {
+                let (mut o, mut d, mut t_min) = (o, d, t_min);
+                match kind {
+                    0 => d.x = -d.x,
+                    1 => d.z = -d.z,
+                    2 => t_min = -t_min,
+                    3 => o *= 1e38,
+                    4 => d = Vec3::ZERO,
+                    _ => {}
+                }
+                Ray::with_range(o, d, t_min, t_min + t_max)
+            })
+            .collect();
+        for isa in Isa::available() {
+            let view = bvh.as_ref().with_isa(isa).unwrap();
+            let (mut got, mut seen) = (vec![None; rays.len()], vec![0u32; rays.len()]);
+            view.occluded_stream(&rays, |i, o| {
+                got[i] = Some(o);
+                seen[i] += 1;
+            });
+            prop_assert!(seen.iter().all(|&n| n == 1), "{}: {:?}", isa, seen);
+            for (i, r) in rays.iter().enumerate() {
+                let want = r.is_valid() && brute_triangles(&pos, &idx, r).is_some();
+                prop_assert_eq!(got[i], Some(want), "{} ray {}: {:?}", isa, i, r);
+            }
+        }
+    }
+
     #[test]
     fn spheres_match_brute_force(
         s in prop::collection::vec((vec3(10.0), 0.05f32..2.0).prop_map(|(c, r)| Sphere::new(c, r)), 1..100),
