@@ -46,26 +46,34 @@ struct PixelWork {
 /// rays are not traced where shading asks about them but gathered for the
 /// whole tile, answered by one
 /// [`SceneQuery::occluded_batch`](rt_core::SceneQuery::occluded_batch)
-/// (rt-accel walks them through the tree together), and their terms added
+/// per kind (rt-accel walks groups of them through the tree together,
+/// faster the more alike a group's rays are: shadow rays toward one light
+/// share their direction, AO rays are short), and their terms added
 /// afterwards. This works because a pixel's colour is linear in each
 /// answer, and nothing else depends on one: a pixel's shadow rays and AO
 /// directions come from its hits and its own random stream, whether or not
 /// an earlier one was blocked.
 #[derive(Default)]
 struct Pending {
-    /// The rays, term after term.
-    rays: Vec<Ray>,
+    /// The rays of each kind ([`SHADOW`], [`AO`]), term after term.
+    rays: [Vec<Ray>; 2],
     /// The terms, in the order of their rays.
     terms: Vec<Term>,
 }
 
+/// [`Pending::rays`] of shadow rays.
+const SHADOW: usize = 0;
+/// [`Pending::rays`] of AO rays.
+const AO: usize = 1;
+
 /// Light that counts in proportion to the open rays among `total`, of
-/// which `traced` wait in [`Pending::rays`] (the others are open).
+/// which `traced` wait in `Pending::rays[kind]` (the others are open).
 struct Term {
     pixel: u32,
     rgb: Vec3,
     traced: u32,
     total: u32,
+    kind: usize,
 }
 
 impl<S: ShadeScene> Ctx<'_, S> {
@@ -116,12 +124,14 @@ impl<S: ShadeScene> Ctx<'_, S> {
             }
         }
         let Pending { rays, terms } = pw.pending;
-        if !rays.is_empty() {
-            let mut occluded = alloc::vec![false; rays.len()];
-            self.scene.occluded_batch(&rays, &mut occluded);
-            let mut answers = occluded.into_iter();
-            for Term { pixel, rgb, traced, total } in terms {
-                let blocked = answers.by_ref().take(traced as usize).filter(|&o| o).count();
+        if !terms.is_empty() {
+            let mut answers = rays.map(|rays| {
+                let mut occluded = alloc::vec![false; rays.len()];
+                self.scene.occluded_batch(&rays, &mut occluded);
+                occluded.into_iter()
+            });
+            for Term { pixel, rgb, traced, total, kind } in terms {
+                let blocked = answers[kind].by_ref().take(traced as usize).filter(|&o| o).count();
                 let open = total - blocked as u32;
                 if open > 0 {
                     let add = rgb * (open as f32 / total as f32);
@@ -144,11 +154,11 @@ impl<S: ShadeScene> Ctx<'_, S> {
         self.scene.closest_hit(ray)
     }
 
-    /// Keeps `ray` for the tile's batch unless it misses the scene's box
-    /// (then it is open without being traced).
-    fn gather(&self, ray: Ray, pw: &mut PixelWork) {
+    /// Keeps `ray` for the tile's batch of its `kind` unless it misses the
+    /// scene's box (then it is open without being traced).
+    fn gather(&self, ray: Ray, kind: usize, pw: &mut PixelWork) {
         if self.bounds.intersect_ray(&ray).is_some() {
-            pw.pending.rays.push(ray);
+            pw.pending.rays[kind].push(ray);
         } else {
             pw.counts.culled += 1;
         }
@@ -156,12 +166,13 @@ impl<S: ShadeScene> Ctx<'_, S> {
 
     /// Leaves the light `rgb` of one term (weighted for its pixel) for the
     /// tile's batch, to count in proportion to the open rays among the
-    /// `total` just gathered, of which those from `first` on were kept.
-    /// Returns whether anything was left (if not, the term is all open).
-    fn term(&self, first: usize, total: u32, rgb: Vec3, pw: &mut PixelWork) -> bool {
-        let traced = (pw.pending.rays.len() - first) as u32;
+    /// `total` of `kind` just gathered, of which those from `first` on
+    /// were kept. Returns whether anything was left (if not, the term is
+    /// all open).
+    fn term(&self, first: usize, total: u32, rgb: Vec3, kind: usize, pw: &mut PixelWork) -> bool {
+        let traced = (pw.pending.rays[kind].len() - first) as u32;
         if traced > 0 {
-            pw.pending.terms.push(Term { pixel: pw.pixel, rgb, traced, total });
+            pw.pending.terms.push(Term { pixel: pw.pixel, rgb, traced, total, kind });
         }
         traced > 0
     }
@@ -314,9 +325,9 @@ impl<S: ShadeScene> Ctx<'_, S> {
             falloff * Vec3::from_array(color) * (m.diffuse * cos * albedo + Vec3::splat(spec));
         if let Some(r) = shadow {
             pw.counts.shadow += 1;
-            let first = pw.pending.rays.len();
-            self.gather(r, pw);
-            if self.term(first, 1, weight * lit, pw) {
+            let first = pw.pending.rays[SHADOW].len();
+            self.gather(r, SHADOW, pw);
+            if self.term(first, 1, weight * lit, SHADOW, pw) {
                 return Vec3::ZERO;
             }
         }
@@ -341,13 +352,13 @@ impl<S: ShadeScene> Ctx<'_, S> {
         }
         let (t, b) = ng.any_orthonormal_pair();
         pw.counts.ao += u64::from(n);
-        let first = pw.pending.rays.len();
+        let first = pw.pending.rays[AO].len();
         for _ in 0..n {
             let l = cosine_hemisphere(uniform2(&mut pw.rng));
             let mut r = spawn_ray(p, err, ng, l.x * t + l.y * b + l.z * ng);
             r.t_max = self.settings.ao_distance;
-            self.gather(r, pw);
+            self.gather(r, AO, pw);
         }
-        if self.term(first, n, rgb, pw) { 0.0 } else { 1.0 }
+        if self.term(first, n, rgb, AO, pw) { 0.0 } else { 1.0 }
     }
 }
