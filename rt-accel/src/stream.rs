@@ -246,16 +246,7 @@ impl<P: Primitive> BvhRef<'_, P> {
             if active != 0 {
                 if cur.is_leaf() {
                     let (first, count) = cur.leaf_range();
-                    let items = self.leaf(first, count);
-                    let mut m = active;
-                    while m != 0 {
-                        let r = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        let ctx = &ctxs[r];
-                        if any_leaf::<P, AVX>(items, ctx, ctx.ray.t_max) {
-                            occluded |= 1 << r;
-                        }
-                    }
+                    occluded |= leaf_group::<P, AVX>(self.leaf(first, count), ctxs, active);
                     if occluded == all {
                         return occluded;
                     }
@@ -274,6 +265,42 @@ impl<P: Primitive> BvhRef<'_, P> {
             Entry { node: cur, rays } = stack.0[sp];
         }
     }
+}
+
+/// Which of the rays in `active` (bits of `ctxs`) hit an item of `items`
+/// (a leaf), each as the single-ray occlusion test answers. On the AVX
+/// kernels a leaf of one triangle packet (most leaves) is tested for two
+/// rays at a time, one in each half of the eight lanes
+/// (`tri_packet::any_pair`).
+#[inline(always)]
+fn leaf_group<P: Primitive, const AVX: bool>(items: &[P], ctxs: &[RayCtx], active: u32) -> u32 {
+    let mut hit = 0;
+    let mut m = active;
+    #[cfg(target_arch = "x86_64")]
+    if AVX && let Some([tri]) = P::as_tri_packets(items) {
+        while m & (m.wrapping_sub(1)) != 0 {
+            let a = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let b = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let (ca, cb) = (&ctxs[a], &ctxs[b]);
+            // SAFETY: `AVX` kernels run only where the CPU has AVX (see
+            // `box_test`).
+            let [ha, hb] = unsafe {
+                crate::tri_packet::any_pair(tri, [(ca, ca.ray.t_max), (cb, cb.ray.t_max)])
+            };
+            hit |= u32::from(ha) << a | u32::from(hb) << b;
+        }
+    }
+    while m != 0 {
+        let r = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let ctx = &ctxs[r];
+        if any_leaf::<P, AVX>(items, ctx, ctx.ray.t_max) {
+            hit |= 1 << r;
+        }
+    }
+    hit
 }
 
 /// Which of the rays in `active` (bits of `ctxs`) enter each child of

@@ -114,43 +114,100 @@ impl Verts for [TriPacket; 2] {
     }
 }
 
+/// What one run of [`lanes`] tests: the triangles in its lanes and the
+/// ray each lane tests them against (one ray in all lanes, or, for the
+/// occlusion streams, two rays against one packet, a ray a half).
+trait Test {
+    type L: Lanes;
+    /// Per lane, the coordinate of vertex `k` along shear axis `i` (axis
+    /// `WatertightRay::axes[i]`) of the lane's ray.
+    ///
+    /// # Safety
+    /// As [`Lanes`].
+    unsafe fn coord(&self, k: usize, i: usize) -> Self::L;
+    /// Per lane, `f` of the lane's ray and its `t_max`.
+    ///
+    /// # Safety
+    /// As [`Lanes`].
+    unsafe fn per_ray(&self, f: impl Fn(&RayCtx, f32) -> f32) -> Self::L;
+}
+
+/// Triangles `V` against one ray, up to `t_max`.
+struct Single<'a, V> {
+    tris: &'a V,
+    ctx: &'a RayCtx,
+    t_max: f32,
+}
+
+impl<V: Verts> Test for Single<'_, V> {
+    type L = V::L;
+    #[inline(always)]
+    unsafe fn coord(&self, k: usize, i: usize) -> V::L {
+        // SAFETY: the caller's guarantee.
+        unsafe { self.tris.coord(k, self.ctx.wt.axes[i]) }
+    }
+    #[inline(always)]
+    unsafe fn per_ray(&self, f: impl Fn(&RayCtx, f32) -> f32) -> V::L {
+        // SAFETY: the caller's guarantee.
+        unsafe { <V::L as Lanes>::splat(f(self.ctx, self.t_max)) }
+    }
+}
+
+/// One packet against two rays (each with its `t_max`): lanes 0–3 the
+/// first ray's, 4–7 the second's.
+#[cfg(target_arch = "x86_64")]
+struct Pair<'a> {
+    tri: &'a TriPacket,
+    rays: [(&'a RayCtx, f32); 2],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Test for Pair<'_> {
+    type L = F32x8;
+    #[inline(always)]
+    unsafe fn coord(&self, k: usize, i: usize) -> F32x8 {
+        let [(a, _), (b, _)] = self.rays;
+        F32x8::from_halves(self.tri.v[k][a.wt.axes[i]], self.tri.v[k][b.wt.axes[i]])
+    }
+    #[inline(always)]
+    unsafe fn per_ray(&self, f: impl Fn(&RayCtx, f32) -> f32) -> F32x8 {
+        let [(a, ta), (b, tb)] = self.rays;
+        F32x8::from_halves([f(a, ta); 4], [f(b, tb); 4])
+    }
+}
+
 /// Lane masks: `(candidates, zero_lanes)` and the lanes' `t`. A candidate
 /// passed the sign test, has `det ≠ 0` and `t ∈ [t_min, t_max]`; zero
 /// lanes must be redone by the scalar test. Lane `l` of two packets is
-/// lane `l % 4` of packet `l / 4`, computed with the same operations.
+/// lane `l % 4` of packet `l / 4`, computed with the same operations; of
+/// a [`Pair`], lane `l % 4` of its packet against ray `l / 4`. Each lane
+/// computes what the four-lane test of its own ray computes.
 ///
 /// # Safety
-/// As [`Lanes`]: `V::L`'s methods may run here.
+/// As [`Lanes`]: `T::L`'s methods may run here.
 #[inline(always)]
-unsafe fn lanes<V: Verts, const EARLY: bool>(
-    tris: &V,
-    ctx: &RayCtx,
-    t_max: f32,
-) -> (u32, u32, <V::L as Lanes>::Array) {
+unsafe fn lanes<T: Test, const EARLY: bool>(test: &T) -> (u32, u32, <T::L as Lanes>::Array) {
     // Vertex `k` relative to the origin, sheared (a function, not a
     // closure: closures are not always inlined, and one left out of line
     // is compiled without the kernel's instruction set).
     #[inline(always)]
-    unsafe fn vert<V: Verts>(tris: &V, ctx: &RayCtx, k: usize) -> (V::L, V::L, V::L) {
-        let [kx, ky, kz] = ctx.wt.axes;
-        let [ox, oy, oz] = ctx.wt_org.to_array();
-        let [sx, sy, _] = ctx.wt.shear.to_array();
+    unsafe fn vert<T: Test>(test: &T, k: usize) -> (T::L, T::L, T::L) {
         // SAFETY: the caller's guarantee.
         unsafe {
-            let splat = <V::L as Lanes>::splat;
-            let x = tris.coord(k, kx).sub(splat(ox));
-            let y = tris.coord(k, ky).sub(splat(oy));
-            let z = tris.coord(k, kz).sub(splat(oz));
-            (x.sub(splat(sx).mul(z)), y.sub(splat(sy).mul(z)), z)
+            let x = test.coord(k, 0).sub(test.per_ray(|c, _| c.wt_org.x));
+            let y = test.coord(k, 1).sub(test.per_ray(|c, _| c.wt_org.y));
+            let z = test.coord(k, 2).sub(test.per_ray(|c, _| c.wt_org.z));
+            let (sx, sy) = (test.per_ray(|c, _| c.wt.shear.x), test.per_ray(|c, _| c.wt.shear.y));
+            (x.sub(sx.mul(z)), y.sub(sy.mul(z)), z)
         }
     }
     // SAFETY: the caller's guarantee.
     unsafe {
-        let splat = <V::L as Lanes>::splat;
-        let sz = splat(ctx.wt.shear.z);
-        let (ax, ay, az) = vert(tris, ctx, 0);
-        let (bx, by, bz) = vert(tris, ctx, 1);
-        let (cx, cy, cz) = vert(tris, ctx, 2);
+        let splat = <T::L as Lanes>::splat;
+        let sz = test.per_ray(|c, _| c.wt.shear.z);
+        let (ax, ay, az) = vert(test, 0);
+        let (bx, by, bz) = vert(test, 1);
+        let (cx, cy, cz) = vert(test, 2);
         let u = cx.mul(by).sub(cy.mul(bx));
         let v = ax.mul(cy).sub(ay.mul(cx));
         let w = bx.mul(ay).sub(by.mul(ax));
@@ -164,7 +221,7 @@ unsafe fn lanes<V: Verts, const EARLY: bool>(
         let any_neg = u.or_bits(v).or_bits(w).sign_mask();
         let all_neg = u.and_bits(v).and_bits(w).sign_mask();
         let one_sign = all_neg | !any_neg;
-        let all = <V::L as Lanes>::ALL;
+        let all = <T::L as Lanes>::ALL;
         if EARLY && (one_sign | on_edge) & all == 0 {
             return (0, 0, zero.to_lanes());
         }
@@ -173,7 +230,8 @@ unsafe fn lanes<V: Verts, const EARLY: bool>(
         let t = tt.mul(splat(1.0).div(det));
         let inf = splat(f32::INFINITY);
         // `t < ∞` as the scalar test: an overflowed `t` is no hit.
-        let in_range = splat(ctx.ray.t_min).le_mask(t) & t.le_mask(splat(t_max)) & t.lt_mask(inf);
+        let (t_min, t_max) = (test.per_ray(|c, _| c.ray.t_min), test.per_ray(|_, t| t));
+        let in_range = t_min.le_mask(t) & t.le_mask(t_max) & t.lt_mask(inf);
         // As the scalar test: an overflowed `det` is no hit.
         let finite = det.lt_mask(inf) & splat(f32::NEG_INFINITY).lt_mask(det);
         let ok = one_sign & !det.eq_mask(zero) & finite & in_range & !on_edge & all;
@@ -226,12 +284,35 @@ pub(crate) unsafe fn any_x8(packets: &[TriPacket], ctx: &RayCtx, t_max: f32) -> 
     let (pairs, rest) = packets.as_chunks::<2>();
     for pair in pairs {
         // SAFETY: the caller guarantees AVX.
-        if any_lane(pair, unsafe { lanes::<_, false>(pair, ctx, t_max) }, ctx, t_max) {
+        let test = Single { tris: pair, ctx, t_max };
+        if any_lane(pair, unsafe { lanes::<_, false>(&test) }, ctx, t_max) {
             return true;
         }
     }
     // A plain `if let`: a closure (`is_some_and`) may be left out of line.
     if let [last] = rest { last.any(ctx, t_max) } else { false }
+}
+
+/// Whether each of two rays (with its `t_max`) hits a triangle of
+/// `packet`: [`Primitive::any`] for both in one eight-lane pass, the same
+/// answers. Occlusion streams test a leaf of one packet (most leaves)
+/// this way for two rays of a group at a time.
+///
+/// # Safety
+/// The CPU must have AVX. Always inlined, into the kernels compiled with it.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) unsafe fn any_pair(packet: &TriPacket, rays: [(&RayCtx, f32); 2]) -> [bool; 2] {
+    // SAFETY: the caller guarantees AVX.
+    let (ok, edge, t) = unsafe { lanes::<_, false>(&Pair { tri: packet, rays }) };
+    let one = core::slice::from_ref(packet);
+    let [(a, ta), (b, tb)] = rays;
+    let low = [t[0], t[1], t[2], t[3]];
+    let high = [t[4], t[5], t[6], t[7]];
+    [
+        any_lane(one, (ok & 0xf, edge & 0xf, low), a, ta),
+        any_lane(one, (ok >> 4, edge >> 4, high), b, tb),
+    ]
 }
 
 impl Sealed for TriPacket {
@@ -250,7 +331,8 @@ impl Primitive for TriPacket {
     #[inline(always)]
     fn closest(&self, item: u32, ctx: &RayCtx, best: &mut BestHit) {
         // SAFETY: four lanes run anywhere.
-        let (mut ok, mut edge, t) = unsafe { lanes::<_, true>(self, ctx, best.t) };
+        let test = Single { tris: self, ctx, t_max: best.t };
+        let (mut ok, mut edge, t) = unsafe { lanes::<_, true>(&test) };
         while ok != 0 {
             let lane = ok.trailing_zeros();
             ok &= ok - 1;
@@ -276,7 +358,7 @@ impl Primitive for TriPacket {
     #[inline(always)]
     fn any(&self, ctx: &RayCtx, t_max: f32) -> bool {
         // SAFETY: four lanes run anywhere.
-        let found = unsafe { lanes::<_, false>(self, ctx, t_max) };
+        let found = unsafe { lanes::<_, false>(&Single { tris: self, ctx, t_max }) };
         any_lane(core::slice::from_ref(self), found, ctx, t_max)
     }
 
