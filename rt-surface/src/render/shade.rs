@@ -82,11 +82,24 @@ impl<S: ShadeScene> Ctx<'_, S> {
         let (tw, th) = (TILE.min(w - x0), TILE.min(h - y0));
         let mut pixels = Vec::with_capacity((tw * th) as usize);
         let stream_seed = self.settings.seed ^ u64::from(pass).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        // Room for the rays of one opaque layer a pixel: growing from
+        // nothing, the batches were copied about ten times a tile.
+        let area = (tw * th) as usize;
+        let shadowed = if self.settings.shadows {
+            self.settings.lights.iter().filter(|l| !matches!(l, Light::Ambient { .. })).count()
+        } else {
+            0
+        };
+        let ao = self.settings.ao_samples as usize;
+        let pending = Pending {
+            rays: [Vec::with_capacity(area * shadowed), Vec::with_capacity(area * ao)],
+            terms: Vec::with_capacity(area * (shadowed + usize::from(ao > 0))),
+        };
         let mut pw = PixelWork {
             rng: rng_for(stream_seed, 0),
             counts: RayCounts::default(),
             pixel: 0,
-            pending: Pending::default(),
+            pending,
         };
         // Camera rays eight pixels of a row at a time, through
         // `SceneQuery::closest_hit_packet` (a BVH traces them as a packet
