@@ -199,9 +199,10 @@ proptest! {
         }
     }
 
-    /// Occlusion streams of shadow-like rays (one direction, origins
-    /// spread, `t_min ≥ 0`: the groups whose rays share an octant take the
-    /// fused node test with the plane rows loaded once), some with a
+    /// Streams of shadow-like rays (one direction, origins spread,
+    /// `t_min ≥ 0`: occlusion groups whose rays share an octant take the
+    /// fused node test with the plane rows loaded once, and closest-hit
+    /// runs of 32 such rays walk the tree as a group), some with a
     /// component's sign flipped (groups of mixed octants), some with
     /// `t_min < 0`, some from past the fused test's range, some invalid:
     /// every answer is brute force's, on every kernel.
@@ -236,9 +237,16 @@ proptest! {
                 seen[i] += 1;
             });
             prop_assert!(seen.iter().all(|&n| n == 1), "{}: {:?}", isa, seen);
+            let mut closest = vec![None; rays.len()];
+            view.closest_t_stream(&rays, |i, h| {
+                closest[i] = h.map(|b| (b.t, b.prim));
+                seen[i] += 1;
+            });
+            prop_assert!(seen.iter().all(|&n| n == 2), "{}: {:?}", isa, seen);
             for (i, r) in rays.iter().enumerate() {
-                let want = r.is_valid() && brute_triangles(&pos, &idx, r).is_some();
-                prop_assert_eq!(got[i], Some(want), "{} ray {}: {:?}", isa, i, r);
+                let want = if r.is_valid() { brute_triangles(&pos, &idx, r) } else { None };
+                prop_assert_eq!(got[i], Some(want.is_some()), "{} ray {}: {:?}", isa, i, r);
+                prop_assert_eq!(closest[i], want, "{} ray {}: {:?}", isa, i, r);
             }
         }
     }
