@@ -217,4 +217,8 @@ impl<P: Primitive> SceneQuery for Bvh<P> {
     fn closest_hit_packet(&self, rays: &[Ray; crate::PACKET]) -> [Option<Hit>; crate::PACKET] {
         self.as_ref().closest_hit_packet(rays)
     }
+
+    fn closest_hit_batch(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        self.as_ref().closest_hit_batch(rays, out);
+    }
 }

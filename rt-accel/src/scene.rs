@@ -48,6 +48,15 @@ impl SceneQuery for Scene {
         core::array::from_fn(|i| self.after_triangles(&rays[i], tri[i]))
     }
 
+    /// The triangles as one stream; spheres and capsules ray by ray, as
+    /// [`Scene::closest_hit`].
+    fn closest_hit_batch(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        self.triangles.closest_hit_batch(rays, out);
+        for (ray, o) in rays.iter().zip(out) {
+            *o = self.after_triangles(ray, *o);
+        }
+    }
+
     fn occluded(&self, ray: &Ray) -> bool {
         self.triangles.occluded(ray) || self.spheres.occluded(ray) || self.capsules.occluded(ray)
     }

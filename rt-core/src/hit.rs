@@ -55,6 +55,16 @@ pub trait SceneQuery {
     fn closest_hit_packet(&self, rays: &[Ray; 8]) -> [Option<Hit>; 8] {
         core::array::from_fn(|i| self.closest_hit(&rays[i]))
     }
+    /// [`SceneQuery::closest_hit`] of many rays: `out[i] =
+    /// closest_hit(&rays[i])` for every `i` below the shorter of the two
+    /// lengths. Scenes that walk coherent rays through the tree together
+    /// (rt-accel's closest-hit streams) override it; the default asks ray
+    /// by ray. Renderers hand over a tile's camera rays at once.
+    fn closest_hit_batch(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        for (ray, o) in rays.iter().zip(out) {
+            *o = self.closest_hit(ray);
+        }
+    }
     /// [`SceneQuery::occluded`] of many rays: `out[i] = occluded(&rays[i])`
     /// for every `i` below the shorter of the two lengths. Scenes that walk
     /// rays through the tree together (rt-accel's occlusion streams)

@@ -80,6 +80,9 @@ impl<S: ShadeScene> SceneQuery for RecordOcclusion<'_, S> {
     fn closest_hit_packet(&self, rays: &[Ray; 8]) -> [Option<Hit>; 8] {
         self.scene.closest_hit_packet(rays)
     }
+    fn closest_hit_batch(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        self.scene.closest_hit_batch(rays, out);
+    }
 }
 
 impl<S: ShadeScene> ShadeScene for RecordOcclusion<'_, S> {
@@ -166,6 +169,9 @@ impl<S: ShadeScene> SceneQuery for AnsweredOcclusion<'_, S> {
     }
     fn closest_hit_packet(&self, rays: &[Ray; 8]) -> [Option<Hit>; 8] {
         self.scene.closest_hit_packet(rays)
+    }
+    fn closest_hit_batch(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        self.scene.closest_hit_batch(rays, out);
     }
 }
 

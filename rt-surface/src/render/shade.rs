@@ -101,40 +101,36 @@ impl<S: ShadeScene> Ctx<'_, S> {
             pixel: 0,
             pending,
         };
-        // Camera rays eight pixels of a row at a time, through
-        // `SceneQuery::closest_hit_packet` (a BVH traces them as a packet
-        // or one by one, whichever its kernel does faster: the same hits);
+        // The tile's camera rays at once, through
+        // `SceneQuery::closest_hit_batch` (a BVH walks runs of coherent
+        // rays through the tree together: the same hits as one by one);
         // each pixel keeps its own random stream for the rest of its path.
-        let none = Ray::new(Vec3::NAN, Vec3::Z);
+        let mut rays = Vec::with_capacity(area);
+        let mut streams = Vec::with_capacity(area);
         for y in y0..y0 + th {
-            let mut x = x0;
-            while x < x0 + tw {
-                let n = (x0 + tw - x).min(8) as usize;
-                let mut rays = [none; 8];
-                let mut streams: [Rng; 8] = core::array::from_fn(|_| pw.rng.clone());
-                for (k, (ray, rng)) in rays.iter_mut().zip(&mut streams).take(n).enumerate() {
-                    let px = x + k as u32;
-                    *rng = rng_for(stream_seed, u64::from(y) * u64::from(w) + u64::from(px));
-                    let jitter = if pass == 0 { Vec2::splat(0.5) } else { uniform2(rng) };
-                    *ray = self.camera.generate_ray(px, y, jitter, uniform2(rng));
-                }
-                // Rays that miss the scene's box are not traced (`closest`).
-                let culled: [bool; 8] = core::array::from_fn(|k| {
-                    k < n && self.bounds.intersect_ray(&rays[k]).is_none()
-                });
-                let traced: [Ray; 8] =
-                    core::array::from_fn(|k| if culled[k] { none } else { rays[k] });
-                let first = self.scene.closest_hit_packet(&traced);
-                for k in 0..n {
-                    pw.rng = streams[k].clone();
-                    pw.pixel = pixels.len() as u32;
-                    pw.counts.primary += 1;
-                    pw.counts.culled += u64::from(culled[k]);
-                    let (rgb, a, depth) = self.path_from(rays[k], first[k], 0, 1.0, &mut pw);
-                    pixels.push(([rgb.x, rgb.y, rgb.z, a], depth));
-                }
-                x += n as u32;
+            for x in x0..x0 + tw {
+                let mut rng = rng_for(stream_seed, u64::from(y) * u64::from(w) + u64::from(x));
+                let jitter = if pass == 0 { Vec2::splat(0.5) } else { uniform2(&mut rng) };
+                rays.push(self.camera.generate_ray(x, y, jitter, uniform2(&mut rng)));
+                streams.push(rng);
             }
+        }
+        // Rays that miss the scene's box are not traced (`closest`).
+        let culled: Vec<bool> =
+            rays.iter().map(|r| self.bounds.intersect_ray(r).is_none()).collect();
+        let traced: Vec<Ray> =
+            rays.iter().zip(&culled).filter(|&(_, &c)| !c).map(|(r, _)| *r).collect();
+        let mut hits = alloc::vec![None; traced.len()];
+        self.scene.closest_hit_batch(&traced, &mut hits);
+        let mut hits = hits.into_iter();
+        for ((ray, rng), culled) in rays.into_iter().zip(streams).zip(culled) {
+            let first = if culled { None } else { hits.next().flatten() };
+            pw.rng = rng;
+            pw.pixel = pixels.len() as u32;
+            pw.counts.primary += 1;
+            pw.counts.culled += u64::from(culled);
+            let (rgb, a, depth) = self.path_from(ray, first, 0, 1.0, &mut pw);
+            pixels.push(([rgb.x, rgb.y, rgb.z, a], depth));
         }
         let Pending { rays, terms } = pw.pending;
         if !terms.is_empty() {

@@ -263,6 +263,10 @@ impl SceneQuery for SurfaceScene<'_> {
         self.scene.closest_hit_packet(rays)
     }
 
+    fn closest_hit_batch(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        self.scene.closest_hit_batch(rays, out);
+    }
+
     fn occluded(&self, ray: &Ray) -> bool {
         self.scene.occluded(ray)
     }

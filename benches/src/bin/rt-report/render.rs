@@ -36,6 +36,9 @@ impl SceneQuery for RayByRay<'_> {
     fn closest_hit_packet(&self, rays: &[Ray; 8]) -> [Option<rt_core::Hit>; 8] {
         self.0.closest_hit_packet(rays)
     }
+    fn closest_hit_batch(&self, rays: &[Ray], out: &mut [Option<rt_core::Hit>]) {
+        self.0.closest_hit_batch(rays, out);
+    }
 }
 
 impl rt_surface::ShadeScene for RayByRay<'_> {
