@@ -383,8 +383,8 @@ fn frames_are_identical_at_any_thread_count() {
     }
     assert!(same(&one, &r.frame().unwrap()));
 
-    // Camera rays go through the scene as packets of eight, and shadow and
-    // AO rays as one batch per tile; asked one by one (the trait's
+    // Camera rays go through the scene as one batch per tile, and shadow
+    // and AO rays as one batch per tile and kind; asked one by one (the trait's
     // defaults), every pixel and count is the same.
     struct OneByOne<'a>(&'a SurfaceScene<'a>);
     impl SceneQuery for OneByOne<'_> {

@@ -23,7 +23,7 @@ use crate::{
 
 /// The scene with every shadow and AO ray traced on its own, as
 /// [`SceneQuery::occluded`] (the trait's default batch), camera rays still
-/// as packets: what the renderer's per-tile occlusion batches save.
+/// batched: what the renderer's per-tile occlusion batches save.
 struct RayByRay<'a>(&'a SurfaceScene<'a>);
 
 impl SceneQuery for RayByRay<'_> {
