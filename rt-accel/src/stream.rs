@@ -429,33 +429,10 @@ fn group_box_test<const AVX: bool, const NONNEG: bool, const FUSED: bool, const 
 ) -> [u32; WIDTH] {
     #[cfg(target_arch = "x86_64")]
     if AVX {
-        use crate::{simd::F32x8, traverse::box_lanes_avx};
-        if FUSED {
-            // SAFETY: `AVX` kernels run only where the CPU has AVX2 and
-            // FMA (see `box_test`); `FUSED` is set only where every `fzs` is
-            // on and every ray has the rows of `ctxs[0]` (the caller's `FUSED`).
-            return unsafe { group_box_fused::<SHARED>(node, ctxs, fzs, active) };
-        }
-        // SAFETY: `AVX` kernels run only where the CPU has AVX2 (see
-        // `box_test`).
-        return unsafe {
-            let mut acc = F32x8::splat_bits(0);
-            let mut m = active;
-            while m != 0 {
-                let r = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let ctx = &ctxs[r];
-                // Widened as in the single-ray occlusion test.
-                let (entered, _) = box_lanes_avx::<NONNEG, false>(
-                    node,
-                    ctx,
-                    &Fused::OFF,
-                    widen_far(ctx.ray.t_max),
-                );
-                acc = acc.or(entered.and(F32x8::splat_bits(1 << r)));
-            }
-            acc.to_bits()
-        };
+        // SAFETY: `AVX` kernels run only where the CPU has AVX2 and FMA
+        // (see `box_test`); `FUSED` is set only where every `fzs` is on
+        // and every ray has the rows of `ctxs[0]` (the caller's `FUSED`).
+        return unsafe { group_box_avx::<NONNEG, FUSED, SHARED>(node, ctxs, fzs, active) };
     }
     let _ = fzs;
     let mut child = [0u32; WIDTH];
@@ -474,18 +451,21 @@ fn group_box_test<const AVX: bool, const NONNEG: bool, const FUSED: bool, const 
     child
 }
 
-/// [`group_box_test`] with the fused test, as the single-ray occlusion
-/// kernel runs it (the same subtrees, so the same answers), the six plane
-/// rows loaded once for the group: its rays share their direction signs,
-/// so they test the same rows, and each ray's test is then six
-/// multiply-adds on registers and the compares.
+/// [`group_box_test`] on the AVX kernels: each ray's entered lanes ORed
+/// into the children's masks as vectors. With `FUSED` each ray takes the
+/// fused test, as the single-ray occlusion kernel does (the same subtrees,
+/// so the same answers), and with `SHARED` too the six plane rows are
+/// loaded once for the group: its rays share their direction signs, so
+/// they test the same rows, and each ray's test is then six multiply-adds
+/// on registers and the compares.
 ///
 /// # Safety
-/// The CPU must have AVX2 and FMA; every ray of `ctxs` must have the
-/// fused test on in `fzs` and the rows (`RayCtx::rows`) of `ctxs[0]`.
+/// The CPU must have AVX2 and FMA; with `FUSED`, every ray of `ctxs` must
+/// have the fused test on in `fzs`, and with `SHARED` the rows
+/// (`RayCtx::rows`) of `ctxs[0]`.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn group_box_fused<const SHARED: bool>(
+unsafe fn group_box_avx<const NONNEG: bool, const FUSED: bool, const SHARED: bool>(
     node: &Node,
     ctxs: &[RayCtx],
     fzs: &[Fused],
@@ -493,7 +473,7 @@ unsafe fn group_box_fused<const SHARED: bool>(
 ) -> [u32; WIDTH] {
     use crate::{
         simd::F32x8,
-        traverse::{fused_lanes, fused_rows},
+        traverse::{box_lanes_avx, fused_lanes, fused_rows},
     };
     // SAFETY: the caller guarantees AVX2, FMA and the fused test's
     // constants; `ctxs` is not empty (the group has a ray).
@@ -506,8 +486,13 @@ unsafe fn group_box_fused<const SHARED: bool>(
             m &= m - 1;
             let ctx = &ctxs[r];
             // Widened as in the single-ray occlusion test.
-            let rows = if SHARED { shared } else { fused_rows(&node.bounds, ctx) };
-            let (entered, _) = fused_lanes(&rows, ctx, &fzs[r], widen_far(ctx.ray.t_max));
+            let t_max = widen_far(ctx.ray.t_max);
+            let (entered, _) = if FUSED {
+                let rows = if SHARED { shared } else { fused_rows(&node.bounds, ctx) };
+                fused_lanes(&rows, ctx, &fzs[r], t_max)
+            } else {
+                box_lanes_avx::<NONNEG, false>(node, ctx, &Fused::OFF, t_max)
+            };
             acc = acc.or(entered.and(F32x8::splat_bits(1 << r)));
         }
         acc.to_bits()
