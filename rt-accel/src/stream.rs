@@ -128,15 +128,16 @@ impl<P: Primitive> BvhRef<'_, P> {
                     None => fused = false,
                 }
             }
-            if !fused || !g.ctxs.iter().all(|c| c.rows == g.ctxs[0].rows) {
+            if !fused {
                 start += GROUP;
                 continue;
             }
             if left < start {
                 self.closest_stream::<true>(&rays[left..start], &mut |i, h| out(left + i, h));
             }
-            // SAFETY: as above; every ray is covered by the fused test and
-            // has the rows of the first.
+            // SAFETY: as above; every ray is covered by the fused test, and
+            // has the rows of the first: `RayCtx` picks them by the signs
+            // of the direction, which the octant compared above.
             unsafe { self.closest_group(&g.ctxs, &g.fzs, &mut best, &mut g.stack) };
             for (r, b) in best.iter().enumerate() {
                 out(start + r, b.is_hit().then_some(*b));
@@ -273,22 +274,20 @@ impl<P: Primitive> BvhRef<'_, P> {
         out: &mut dyn FnMut(usize, bool),
     ) {
         let Some(mut group) = Group::new() else { return };
-        let mut index = [0usize; GROUP];
-        for start in (0..rays.len()).step_by(GROUP) {
-            let n = GROUP.min(rays.len() - start);
-            index.iter_mut().zip(start..).for_each(|(i, s)| *i = s);
-            self.occluded_rays::<AVX>(rays, &index[..n], &mut group, out);
+        for (c, chunk) in rays.chunks(GROUP).enumerate() {
+            self.occluded_rays::<AVX>(chunk, c * GROUP, &mut group, out);
         }
     }
 
-    /// Answers `rays[i]` for every `i` of `index` (at most [`GROUP`]): the
-    /// invalid rays miss, the others walk the tree as one group with the
-    /// fastest box test that holds for all of them.
+    /// Answers the rays of `chunk` (at most [`GROUP`], `chunk[k]` being
+    /// ray `first + k` of the stream): the invalid rays miss, the others
+    /// walk the tree as one group with the fastest box test that holds for
+    /// all of them.
     #[inline(always)]
     fn occluded_rays<const AVX: bool>(
         &self,
-        rays: &[Ray],
-        index: &[usize],
+        chunk: &[Ray],
+        first: usize,
         g: &mut Group,
         out: &mut dyn FnMut(usize, bool),
     ) {
@@ -298,8 +297,8 @@ impl<P: Primitive> BvhRef<'_, P> {
         // fused test covers every ray (only on the AVX kernels, see
         // `ray_constants`).
         let (mut nonneg, mut fused) = (true, true);
-        for &i in index {
-            let Some((ctx, fz)) = self.ray_constants::<AVX>(&rays[i]) else {
+        for (i, ray) in (first..).zip(chunk) {
+            let Some((ctx, fz)) = self.ray_constants::<AVX>(ray) else {
                 out(i, false);
                 continue;
             };
@@ -312,8 +311,8 @@ impl<P: Primitive> BvhRef<'_, P> {
             return;
         }
         let (ctxs, fzs, stack) = (&g.ctxs[..n], &g.fzs[..n], &mut g.stack);
-        // The rays of a group share their octant, hence their plane rows,
-        // which `group_box_fused` loads from the first ray's (checked).
+        // Where the rays share their octant, hence their plane rows
+        // (shadow rays toward one light), `group_box_avx` loads them once.
         let hit = if fused && ctxs.iter().all(|c| c.rows == ctxs[0].rows) {
             self.occluded_group::<AVX, true, true, true>(ctxs, fzs, stack)
         } else if fused {
@@ -413,10 +412,11 @@ fn leaf_group<P: Primitive, const AVX: bool>(items: &[P], ctxs: &[RayCtx], activ
 
 /// Which of the rays in `active` (bits of `ctxs`) enter each child of
 /// `node`, each ray tested with the single-ray occlusion test: the
-/// fused one with the plane rows loaded once for the group (`FUSED`: the
-/// test covers every ray, and all have the same octant, see
-/// `group_box_fused`), else the robust one, short where every ray has
-/// `t_min ≥ 0` (`NONNEG`, see `box_test`: shadow and AO streams +2–5 %).
+/// fused one where it covers every ray (`FUSED`), with the plane rows
+/// loaded once for the group where all rays have the same octant
+/// (`SHARED`, see `group_box_avx`), else the robust one, short where every
+/// ray has `t_min ≥ 0` (`NONNEG`, see `box_test`: shadow and AO streams
+/// +2–5 %).
 /// The AVX kernels gather the rays' bits with two vector operations per
 /// ray; the 4-wide one bit by bit. Branch-free: which children a ray
 /// enters is unpredictable.
@@ -430,8 +430,9 @@ fn group_box_test<const AVX: bool, const NONNEG: bool, const FUSED: bool, const 
     #[cfg(target_arch = "x86_64")]
     if AVX {
         // SAFETY: `AVX` kernels run only where the CPU has AVX2 and FMA
-        // (see `box_test`); `FUSED` is set only where every `fzs` is on
-        // and every ray has the rows of `ctxs[0]` (the caller's `FUSED`).
+        // (see `box_test`); the caller sets `FUSED` only where every `fzs`
+        // is on, and `SHARED` only where every ray has the rows of
+        // `ctxs[0]`.
         return unsafe { group_box_avx::<NONNEG, FUSED, SHARED>(node, ctxs, fzs, active) };
     }
     let _ = fzs;

@@ -53,7 +53,6 @@ struct PixelWork {
 /// answer, and nothing else depends on one: a pixel's shadow rays and AO
 /// directions come from its hits and its own random stream, whether or not
 /// an earlier one was blocked.
-#[derive(Default)]
 struct Pending {
     /// The rays of each kind ([`SHADOW`], [`AO`]), term after term.
     rays: [Vec<Ray>; 2],
@@ -80,11 +79,11 @@ impl<S: ShadeScene> Ctx<'_, S> {
     pub(super) fn tile(&self, x0: u32, y0: u32, pass: u32) -> TileResult {
         let (w, h) = (self.camera.width, self.camera.height);
         let (tw, th) = (TILE.min(w - x0), TILE.min(h - y0));
-        let mut pixels = Vec::with_capacity((tw * th) as usize);
+        let area = (tw * th) as usize;
+        let mut pixels = Vec::with_capacity(area);
         let stream_seed = self.settings.seed ^ u64::from(pass).wrapping_mul(0x9e37_79b9_7f4a_7c15);
         // Room for the rays of one opaque layer a pixel: growing from
         // nothing, the batches were copied about ten times a tile.
-        let area = (tw * th) as usize;
         let shadowed = if self.settings.shadows {
             self.settings.lights.iter().filter(|l| !matches!(l, Light::Ambient { .. })).count()
         } else {
