@@ -99,10 +99,12 @@ pub struct BuildParams {
     /// The binary builder and its preset.
     pub quality: BuildQuality,
     /// Most primitives per leaf, `1..=16` (clamped). Triangles are tested
-    /// four at a time; leaves of up to 8 (two packets) make the tree
-    /// shallower, which pays for incoherent rays (`rt-report traversal`:
-    /// leaf 4 → 8 took incoherent rays from 0.92–0.95× to 1.0–1.05× of
-    /// obvhs's CWBVH, primary rays unchanged).
+    /// four at a time; leaves of several packets make the tree shallower,
+    /// which pays for incoherent rays (`rt-report traversal`: leaf 4 → 8
+    /// took incoherent rays from 0.92–0.95× to 1.0–1.05× of obvhs's
+    /// CWBVH, primary rays unchanged). [`BuildParams::medium`] allows 12
+    /// (three packets), which its node weight needs (`TRI_NODE_COST` in
+    /// `build.rs`); 16 measured the same.
     pub max_leaf_size: u32,
 }
 
@@ -117,7 +119,7 @@ impl BuildParams {
     /// ([`BuildQuality::BinnedSah`]).
     #[must_use]
     pub const fn medium() -> Self {
-        Self { quality: BuildQuality::BinnedSah, max_leaf_size: 8 }
+        Self { quality: BuildQuality::BinnedSah, max_leaf_size: 12 }
     }
 
     /// obvhs's slow preset (more reinsertion, spatial pre-splits): a
@@ -186,6 +188,7 @@ pub fn build_triangles(
         bvh2.as_ref(),
         max_leaf,
         |n| n.div_ceil(4),
+        TRI_NODE_COST,
         |prims, items: &mut Vec<TriPacket>| {
             for chunk in prims.chunks(4) {
                 let mut packet = TriPacket::EMPTY;
@@ -279,6 +282,7 @@ fn build_items<P: Primitive>(prims: Vec<P>, params: &BuildParams) -> Result<Bvh<
         bvh2.as_ref(),
         max_leaf,
         |n| n,
+        SHAPE_NODE_COST,
         |ids, items: &mut Vec<P>| {
             items.extend(ids.iter().map(|&i| prims[i as usize]));
         },
@@ -305,11 +309,30 @@ fn to_aabb(b: &obvhs::aabb::Aabb) -> Aabb {
 
 /// The collapse's surface area heuristic weighs every test by the surface
 /// area of the box that leads to it (the chance a ray gets there). This is
-/// the cost of testing one wide node's boxes.
-const NODE_COST: f64 = 1.0;
-/// The cost of testing one leaf item (four triangles, a sphere, a
-/// capsule). Weights of 0.5–2 against [`NODE_COST`] measured the same.
+/// the cost of testing one leaf item (four triangles, a sphere, a
+/// capsule); a wide node's test is weighed against it.
 const ITEM_COST: f64 = 1.0;
+/// The cost of one wide node's test above triangle packets: three packets.
+/// A node is one more fetch on the chain from root to leaf, where a
+/// leaf's packets lie side by side and are fetched together; on
+/// million-triangle scenes that chain sets the time. At this weight a
+/// node costs more than a leaf of up to three packets over the same box,
+/// so a subtree of at most `max_leaf_size` triangles becomes a leaf (or
+/// is spread over its parent's free slots), never a small node of its
+/// own. Against a weight of 1 (with leaves of up
+/// to 8 triangles, not 12) the trees have 40–42 % fewer nodes (terrain
+/// 50 175 → 28 903, icosphere 60 509 → 36 598) and the single-ray rows
+/// of `rt-report traversal` against Embree 3 in the same process went
+/// (Zen 4, 12 interleaved rounds each, medians; primary, shadow, AO,
+/// incoherent): terrain 1.05, 1.03, 1.02, 0.97 → 1.05, 1.09, 1.09,
+/// 1.13×; icosphere 0.99, 0.99, 1.05, 0.99 → 1.00, 1.06, 1.10, 1.06×.
+/// Weights of 4–8 took icosphere primary rays below 1.0×; 2 and 2.5
+/// gained less on the other rows.
+const TRI_NODE_COST: f64 = 3.0;
+/// The cost of one wide node's test above spheres and capsules (items of
+/// one primitive each): the weight triangles had before, not measured
+/// again for shapes.
+const SHAPE_NODE_COST: f64 = 1.0;
 
 /// How a binary subtree is laid out among `s` child slots of a wide node.
 #[derive(Clone, Copy, Debug)]
@@ -337,7 +360,7 @@ struct Plan {
 impl Plan {
     /// `items(p)`: leaf items that `p` primitives take; a leaf holds at
     /// most `max_leaf` primitives.
-    fn new(b2: &Bvh2, max_leaf: u32, items: impl Fn(u32) -> u32) -> Self {
+    fn new(b2: &Bvh2, max_leaf: u32, items: impl Fn(u32) -> u32, node_cost: f64) -> Self {
         let n = b2.nodes.len();
         // In f64, from the boxes' f32 corners: every area and sum is
         // finite (a box's extent may overflow f32), so every inner node
@@ -375,7 +398,7 @@ impl Plan {
                 }
             }
             let leaf = if prims[i] <= max_leaf { leaf_cost(prims[i]) } else { f64::INFINITY };
-            let inner = area * NODE_COST + split[WIDTH - 1].0;
+            let inner = area * node_cost + split[WIDTH - 1].0;
             wide[i] = split[WIDTH - 1].1;
             (cost[i][0], choice[i][0]) =
                 if leaf <= inner { (leaf, Choice::Leaf) } else { (inner, Choice::Node) };
@@ -448,6 +471,7 @@ fn convert<P: Primitive>(
     bvh2: Option<&Bvh2>,
     max_leaf: u32,
     items_of: impl Fn(u32) -> u32,
+    node_cost: f64,
     mut emit_leaf: impl FnMut(&[u32], &mut Vec<P>),
 ) -> Result<(Vec<Node>, Vec<P>), BuildError> {
     let mut nodes = Vec::new();
@@ -458,7 +482,7 @@ fn convert<P: Primitive>(
     if b2.nodes.is_empty() {
         return Ok((nodes, items));
     }
-    let plan = Plan::new(b2, max_leaf, items_of);
+    let plan = Plan::new(b2, max_leaf, items_of, node_cost);
     nodes.push(Node::EMPTY);
     // `work[i]` = (binary node, depth) of wide node `i`; processing in index
     // order while appending children gives breadth-first order.
@@ -544,10 +568,16 @@ mod tests {
 
     /// Collapses `b2` into triangle packets; the primitives of each leaf.
     fn collapse(b2: &Bvh2, max_leaf: u32) -> (Vec<Node>, Vec<Vec<u32>>) {
+        collapse_weighed(b2, max_leaf, TRI_NODE_COST)
+    }
+
+    /// [`collapse`] with a node weighed as `node_cost` packets.
+    fn collapse_weighed(b2: &Bvh2, max_leaf: u32, node_cost: f64) -> (Vec<Node>, Vec<Vec<u32>>) {
         let (nodes, items) = convert(
             Some(b2),
             max_leaf,
             |n| n.div_ceil(4),
+            node_cost,
             |prims, items| {
                 for chunk in prims.chunks(4) {
                     let mut p = TriPacket::EMPTY;
@@ -581,14 +611,32 @@ mod tests {
 
     #[test]
     fn sixty_four_far_apart_leaves_make_nine_full_nodes() {
-        // Far apart: merging any two into a leaf costs more than a slot.
+        // Far apart, a node weighed as one packet: merging any two into a
+        // leaf costs more than a slot.
         let boxes: Vec<_> = (0..64).map(|i| unit_box(100.0 * i as f32, 0.0)).collect();
-        let (nodes, leaves) = collapse(&balanced(&boxes, false), 8);
+        let (nodes, leaves) = collapse_weighed(&balanced(&boxes, false), 8, 1.0);
         assert_eq!(nodes.len(), 9);
         assert!(nodes.iter().all(|n| fill(n) == WIDTH));
         let mut prims: Vec<u32> = leaves.concat();
         prims.sort_unstable();
         assert_eq!(prims, (0..64).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn a_node_weighed_as_three_packets_gives_way_to_leaves_of_two() {
+        // The same boxes with the triangles' weight: a leaf of two packets
+        // costs less than a node over the same box, however far apart its
+        // primitives, so the root holds eight leaves of eight.
+        let boxes: Vec<_> = (0..64).map(|i| unit_box(100.0 * i as f32, 0.0)).collect();
+        let (nodes, leaves) = collapse(&balanced(&boxes, false), 8);
+        assert_eq!((nodes.len(), fill(&nodes[0])), (1, WIDTH));
+        assert!(leaves.iter().all(|l| l.len() == 8), "{leaves:?}");
+        // Leaves of one packet at most: sixteen or more leaves do not fit
+        // one node's slots, so wide nodes come back below the root.
+        let (nodes, leaves) = collapse(&balanced(&boxes, false), 4);
+        assert_eq!(nodes.len(), 3);
+        assert!(leaves.len() >= 16 && leaves.iter().all(|l| l.len() <= 4), "{leaves:?}");
+        assert_eq!(leaves.concat().len(), 64);
     }
 
     #[test]

@@ -112,7 +112,7 @@ fn edit_items<P: Primitive>(bytes: &[u8], f: impl FnOnce(&mut Vec<P>)) -> Vec<u8
 
 /// A triangle BVH of several levels with partly filled packets.
 fn tri_bvh() -> TriBvh {
-    let (pos, idx) = icosphere(2);
+    let (pos, idx) = icosphere(3);
     build_triangles(&pos, &idx, &params()).unwrap()
 }
 
