@@ -411,7 +411,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                     let r = bits.trailing_zeros() as usize;
                     bits &= bits - 1;
                     if let Some(ctx) = &l.ctx[r] {
-                        closest_leaf(self.leaf(first, count), first, ctx, &mut best[r]);
+                        closest_leaf::<_, AVX>(self.leaf(first, count), first, ctx, &mut best[r]);
                     }
                 }
             } else {

@@ -183,7 +183,7 @@ impl<P: Primitive> BvhRef<'_, P> {
                 while m != 0 {
                     let r = m.trailing_zeros() as usize;
                     m &= m - 1;
-                    crate::prim::closest_leaf(items, first, &ctxs[r], &mut best[r]);
+                    crate::prim::closest_leaf::<_, true>(items, first, &ctxs[r], &mut best[r]);
                 }
             } else {
                 let node = self.node(cur);

@@ -458,7 +458,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         if cur.is_leaf() {
             let (first, count) = cur.leaf_range();
             stats.items += count as u32;
-            closest_leaf(self.leaf(first, count), first, ctx, best);
+            closest_leaf::<_, AVX>(self.leaf(first, count), first, ctx, best);
         } else {
             stats.nodes += 1;
             let node = self.node(*cur);

@@ -273,6 +273,67 @@ fn any_lane(
     false
 }
 
+/// Offers to `best` the hits among the lanes [`lanes`] found for
+/// `packets` (leaf items `item..`): candidates that pass the scalar
+/// test's final box check, then the zero lanes and the rest, settled by
+/// the scalar test up to the best hit so far.
+#[inline(always)]
+fn offer_lanes(
+    packets: &[TriPacket],
+    item: u32,
+    (mut ok, mut edge, t): (u32, u32, impl core::ops::Index<usize, Output = f32>),
+    ctx: &RayCtx,
+    best: &mut BestHit,
+) {
+    while ok != 0 {
+        let l = ok.trailing_zeros() as usize;
+        ok &= ok - 1;
+        let (p, lane) = (&packets[l / 4], l % 4);
+        if p.admits(lane, ctx, t[l]) {
+            best.offer(t[l], p.prims[lane], item + (l / 4) as u32, lane as u32);
+        } else {
+            // Rounded below its box: the scalar test settles it.
+            edge |= 1 << l;
+        }
+    }
+    if edge != 0 {
+        let r = Ray { t_max: best.t, ..ctx.ray };
+        while edge != 0 {
+            let l = edge.trailing_zeros() as usize;
+            edge &= edge - 1;
+            let (p, lane) = (&packets[l / 4], l % 4);
+            if let Some(h) = p.scalar(lane, &r, ctx) {
+                best.offer(h.t, p.prims[lane], item + (l / 4) as u32, lane as u32);
+            }
+        }
+    }
+}
+
+/// [`Primitive::closest`] over a leaf's packets (leaf items `first..`),
+/// two at a time in eight lanes: the same best hit as one packet after
+/// the other, since [`BestHit::offer`] does not depend on the order.
+///
+/// # Safety
+/// The CPU must have AVX. Always inlined, into the kernels compiled with it.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) unsafe fn closest_x8(
+    packets: &[TriPacket],
+    first: usize,
+    ctx: &RayCtx,
+    best: &mut BestHit,
+) {
+    let (pairs, rest) = packets.as_chunks::<2>();
+    for (k, pair) in pairs.iter().enumerate() {
+        // SAFETY: the caller guarantees AVX.
+        let found = unsafe { lanes::<_, true>(&Single { tris: pair, ctx, t_max: best.t }) };
+        offer_lanes(pair, (first + 2 * k) as u32, found, ctx, best);
+    }
+    if let [last] = rest {
+        last.closest((first + packets.len() - 1) as u32, ctx, best);
+    }
+}
+
 /// [`Primitive::any`] over a leaf's packets, two at a time in eight
 /// lanes: the same answer as one packet after the other.
 ///
@@ -331,28 +392,8 @@ impl Primitive for TriPacket {
     #[inline(always)]
     fn closest(&self, item: u32, ctx: &RayCtx, best: &mut BestHit) {
         // SAFETY: four lanes run anywhere.
-        let test = Single { tris: self, ctx, t_max: best.t };
-        let (mut ok, mut edge, t) = unsafe { lanes::<_, true>(&test) };
-        while ok != 0 {
-            let lane = ok.trailing_zeros();
-            ok &= ok - 1;
-            if self.admits(lane as usize, ctx, t[lane as usize]) {
-                best.offer(t[lane as usize], self.prims[lane as usize], item, lane);
-            } else {
-                // Rounded below its box: the scalar test settles it.
-                edge |= 1 << lane;
-            }
-        }
-        if edge != 0 {
-            let r = Ray { t_max: best.t, ..ctx.ray };
-            while edge != 0 {
-                let lane = edge.trailing_zeros();
-                edge &= edge - 1;
-                if let Some(h) = self.scalar(lane as usize, &r, ctx) {
-                    best.offer(h.t, self.prims[lane as usize], item, lane);
-                }
-            }
-        }
+        let found = unsafe { lanes::<_, true>(&Single { tris: self, ctx, t_max: best.t }) };
+        offer_lanes(core::slice::from_ref(self), item, found, ctx, best);
     }
 
     #[inline(always)]
