@@ -319,13 +319,13 @@ const ITEM_COST: f64 = 1.0;
 /// node costs more than a leaf of up to three packets over the same box,
 /// so a subtree of at most `max_leaf_size` triangles becomes a leaf (or
 /// is spread over its parent's free slots), never a small node of its
-/// own. Against a weight of 1 (with leaves of up
-/// to 8 triangles, not 12) the trees have 40–42 % fewer nodes (terrain
-/// 50 175 → 28 903, icosphere 60 509 → 36 598) and the single-ray rows
-/// of `rt-report traversal` against Embree 3 in the same process went
-/// (Zen 4, 12 interleaved rounds each, medians; primary, shadow, AO,
-/// incoherent): terrain 1.05, 1.03, 1.02, 0.97 → 1.05, 1.09, 1.09,
-/// 1.13×; icosphere 0.99, 0.99, 1.05, 0.99 → 1.00, 1.06, 1.10, 1.06×.
+/// own. Against a weight of 1 (with leaves of up to 8 triangles, not 12)
+/// the trees have 40–42 % fewer nodes (terrain 50 175 → 28 903,
+/// icosphere 60 509 → 36 598) and the single-ray rows of `rt-report
+/// traversal` against Embree 3 in the same process went (Zen 4, 12
+/// interleaved rounds each, medians; primary, shadow, AO, incoherent):
+/// terrain 1.05, 1.03, 1.02, 0.97 → 1.05, 1.09, 1.09, 1.13×; icosphere
+/// 0.99, 0.99, 1.05, 0.99 → 1.00, 1.06, 1.10, 1.06×.
 /// Weights of 4–8 took icosphere primary rays below 1.0×; 2 and 2.5
 /// gained less on the other rows.
 const TRI_NODE_COST: f64 = 3.0;
