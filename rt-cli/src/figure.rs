@@ -464,8 +464,9 @@ fn color_bar(
         } else {
             (range.end - t * (range.end - range.start)) as f32
         };
-        let c = map.map(s);
-        let rgb = [c[0], c[1], c[2]].map(|c| (linear_to_srgb(c) * 255.0 + 0.5) as u8);
+        // The table's own sRGB values: the PNG is sRGB.
+        let c = map.map_srgb(s);
+        let rgb = [c[0], c[1], c[2]].map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
         for _ in 0..bw {
             px.extend(rgb);
         }

@@ -2,6 +2,8 @@
 Lambert image, and pieces rendered apart then composited against the
 whole scene rendered at once, bit for bit."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -54,6 +56,35 @@ def test_meshes_tubes_and_colour_maps():
     middle = rgba[32, 32, :3]
     assert middle[0] > 0.5 and middle[1] < 0.05 and middle[2] < 0.05
     assert depth[32, 32] < depth[20, 18]  # the tube is in front of the square
+
+
+def _published_viridis():
+    # matplotlib's 256 sRGB entries, copied into the repository beside
+    # rt-core's own table test.
+    path = Path(__file__).resolve().parents[2] / "rt-core" / "tests" / "data" / "viridis.csv"
+    return np.loadtxt(path, delimiter=",", comments=("#", "r"))
+
+
+def test_a_ramp_under_ambient_light_is_the_published_viridis():
+    # Scalar = x on a square filling an orthographic view, ambient light 1:
+    # the displayed 8-bit colour of each pixel is viridis at its scalar, as
+    # matplotlib publishes it (interpolated between entries), within one
+    # step: not encoded to sRGB a second time.
+    pts = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], dtype=np.float64)
+    tris = np.array([[0, 1, 2], [0, 2, 3]], dtype=np.int32)
+    scene = rtvis.Scene().add_mesh(pts, tris, scalars=pts[:, 0], colormap="viridis",
+                                   range=(-1.0, 1.0), material="matte")
+    w, h = 256, 4
+    cam = rtvis.Camera((0.0, 0.0, 5.0), (0.0, 0.0, 0.0), ortho_height=2.0 * h / w)
+    rgba, _ = scene.render(cam, size=(w, h), lights=[("ambient", (1.0, 1.0, 1.0))], shadows=False)
+    shown = rtvis.to_srgb8(rgba).astype(np.int32)
+    x = (2.0 * (np.arange(w) + 0.5) / w - 1.0)  # the scalar at each column
+    table = _published_viridis()
+    pos = np.linspace(0.0, 1.0, len(table))
+    want = np.stack([np.interp((x + 1.0) / 2.0, pos, table[:, k]) for k in range(3)], axis=-1)
+    want = np.round(want * 255.0).astype(np.int32)
+    assert np.abs(shown[h // 2] - want).max() <= 1
+    assert shown[h // 2, 128].tolist() == pytest.approx([33, 145, 140], abs=1)
 
 
 def test_pieces_composite_to_the_whole_scene_bit_for_bit():

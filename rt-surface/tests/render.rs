@@ -2,8 +2,8 @@
 
 use rt_accel::BuildParams;
 use rt_core::{
-    Aabb, Camera, ColorMap, ColorStop, Frame, Hit, Projection, Ray, SceneQuery, glam::Vec3,
-    intersect::Sphere,
+    Aabb, Camera, ColorMap, ColorStop, Frame, Hit, Projection, Ray, SceneQuery,
+    frame::linear_to_srgb, glam::Vec3, intersect::Sphere,
 };
 use rt_surface::{
     Glyphs, Light, Material, MaterialError, Mesh, MeshError, ObjectKind, Paint, Renderer,
@@ -202,9 +202,62 @@ fn colour_maps_the_interpolated_scalar_not_interpolated_colours() {
     let (f, _) = render(&s, down_at(0.5, 0.25), st.clone(), 1);
     let c = f.get(0, 0).unwrap().color;
     assert!(c[1] > 0.999 && c[0] < 1e-3 && c[2] < 1e-3, "{c:?}");
+    // Halfway between red and green stops: (½, ½, 0) on the sRGB curve,
+    // which the frame holds decoded to linear.
     let (f, _) = render(&s, down_at(0.25, 0.25), st, 1);
-    let c = f.get(0, 0).unwrap().color;
+    let c = f.get(0, 0).unwrap().color.map(linear_to_srgb);
     assert!((c[0] - 0.5).abs() < 1e-3 && (c[1] - 0.5).abs() < 1e-3 && c[2] < 1e-3, "{c:?}");
+}
+
+#[test]
+fn a_ramp_under_ambient_light_shows_the_published_colour_map() {
+    // Scalar = x on a unit triangle strip, lit by ambient 1 only: the 8-bit
+    // sRGB frame is the colour map itself. Published entries (matplotlib's
+    // viridis at 0, 128/255, 1; Moreland's cool-to-warm ends and middle)
+    // must come out as published, not encoded a second time.
+    let mesh = Mesh::new(
+        vec![
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+        ],
+        vec![[0, 1, 2], [2, 1, 3]],
+        Some(vec![0.0, 0.0, 1.0, 1.0]),
+    )
+    .unwrap();
+    // (scalar, published 8-bit sRGB) per map.
+    type Entries = [(f32, [u8; 3]); 3];
+    let cases: [(ColorMap<'static>, Entries); 2] = [
+        (
+            ColorMap::viridis(),
+            [(0.0, [68, 1, 84]), (128.0 / 255.0, [33, 145, 140]), (1.0, [253, 231, 37])],
+        ),
+        (
+            ColorMap::cool_to_warm(),
+            [(0.0, [59, 76, 192]), (0.5, [221, 221, 221]), (1.0, [180, 4, 38])],
+        ),
+    ];
+    let st = settings(vec![Light::Ambient { color: [1.0; 3] }]);
+    for (map, entries) in cases {
+        let s = SurfaceScene::build(
+            vec![(mesh.clone(), Paint::Mapped(map), Material::MATTE)],
+            vec![],
+            vec![],
+            &BuildParams::medium(),
+        )
+        .unwrap();
+        for (x, want) in entries {
+            // Just inside the strip at its ends.
+            let x = x.clamp(1e-6, 1.0 - 1e-6);
+            let (f, _) = render(&s, down_at(x, 0.0), st.clone(), 1);
+            let px = f.to_srgba8();
+            for k in 0..3 {
+                let d = i32::from(px[k]) - i32::from(want[k]);
+                assert!(d.abs() <= 1, "x {x}: {:?} vs published {want:?}", &px[..3]);
+            }
+        }
+    }
 }
 
 fn view() -> Camera {
