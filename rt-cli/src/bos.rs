@@ -8,11 +8,13 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use rt_photo::{
-    Background, Bos, DotBackground, DotGrid, FilterImage, ImageBackground, Sensor, ThinLens,
+    Background, Bos, BosRig, BosRigOptions, Cutoff, DotBackground, DotGrid, FilterImage,
+    ImageBackground, Mode, Sensor, ThinLens,
 };
 use rt_volume::io::{is_unstructured, read_grid};
 
 use crate::{
+    figure::{Figure, Image, Legend, significant},
     image,
     optics::{Axis, Interpolation, MeshOptions, Samples, Source, Volume},
     parse,
@@ -42,21 +44,26 @@ pub struct Args {
     /// Image width in pixels (height follows the volume's aspect).
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=8192))]
     pub size: u32,
-    /// Lens focal length in metres.
-    #[arg(long, default_value_t = 0.1, value_parser = parse::positive, allow_hyphen_values = true)]
-    pub focal_length: f64,
+    /// Lens focal length in metres [default: of the usual lenses (24 mm to
+    /// 400 mm), the one that fills the image with the volume about 1.5 m
+    /// away].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub focal_length: Option<f64>,
     /// f-number N (aperture diameter f/N): larger blurs the flow less.
     #[arg(long, default_value_t = 16.0, value_parser = parse::positive, allow_hyphen_values = true)]
     pub f_number: f64,
-    /// Sensor pixel pitch in metres.
-    #[arg(long, default_value_t = 5e-6, value_parser = parse::positive, allow_hyphen_values = true)]
-    pub pixel: f64,
+    /// Pitch of an image pixel on the sensor, metres [default: a 2048 ×
+    /// 5.5e-6 m sensor (11.3 mm) binned to --size pixels].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub pixel: Option<f64>,
     /// Distance from the lens to the volume's centre (Z_A) in metres
     /// [default: the volume's cross-section fills the image width].
     #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
     pub distance: Option<f64>,
     /// Distance from the volume's centre to the background (Z_D) in
-    /// metres [default: the camera's distance, Z_A].
+    /// metres [default: chosen from a survey of the flow's deflections so
+    /// that their 99th percentile moves the image 4 px, between 0.6× the
+    /// volume's depth and 2 Z_A].
     #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
     pub background_distance: Option<f64>,
     /// The background: `random` dots, a `grid` of dots (both sized by
@@ -105,9 +112,12 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Output stem: writes `<stem>-reference.png`, `<stem>-flow.png`,
-    /// `<stem>-displacement.png` (hue: direction, saturation: size) and
-    /// `<stem>-displacement.json` + `.raw` (float32 Δx, Δy per pixel, in
-    /// pixels, x right and y down).
+    /// `<stem>-displacement.png` (hue: direction, saturation: size, with
+    /// its colour wheel) and `<stem>-displacement.json` + `.raw` (float32
+    /// Δx, Δy per pixel, in pixels, x right and y down). The displacement
+    /// is the ground truth in the convention of PIV/BOS software: the
+    /// apparent motion of the background pattern from the reference image
+    /// to the flow image.
     #[arg(long, default_value = "out/bos.png")]
     pub out: PathBuf,
 }
@@ -134,11 +144,9 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 /// A bad set-up or an unwritable output.
 pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     let t = std::time::Instant::now();
-    let bos = prepare(volume, a)?;
+    let (bos, rig) = prepare(volume, a)?;
     let camera = bos.camera;
     let (w, h) = (camera.width, camera.height);
-    let (f, z_a) = (camera.focal_length, a.distance_or_default(volume));
-    let z_d = camera.focus_distance - z_a;
     let images = volume.bos(&bos, a.seed)?;
     let sensor = Sensor {
         exposure: a.exposure,
@@ -158,23 +166,11 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     ];
     image::write_counts(&reference, a.bits, w32, h32, &paths[0])?;
     image::write_counts(&flow, a.bits, w32, h32, &paths[1])?;
-    let mags: Vec<f64> = images.displacement.iter().map(|d| d[0].hypot(d[1])).collect();
-    let mut sorted = mags.clone();
+    let mut sorted: Vec<f64> = images.displacement.iter().map(|d| d[0].hypot(d[1])).collect();
     sorted.sort_by(f64::total_cmp);
-    let p99 = sorted[((sorted.len() - 1) as f64 * 0.99) as usize].max(1e-6);
     let max = sorted.last().copied().unwrap_or(0.0);
-    // Hue: direction (x right, y up on the wheel); saturation: |Δ| over
-    // the largest (the wheel is black beyond its rim).
-    let wheel = FilterImage::hue_wheel(256, max.max(1e-9) * 1.000_001);
-    let rgb: Vec<u8> = images
-        .displacement
-        .iter()
-        .flat_map(|d| {
-            let c = wheel.at(d[0], -d[1]);
-            c.map(|x| (rt_core::frame::linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0).round() as u8)
-        })
-        .collect();
-    image::write_rgb8(&rgb, w32, h32, &paths[2])?;
+    let p99 = sorted[((sorted.len() - 1) as f64 * 0.99) as usize];
+    displacement_figure(&images.displacement, (w32, h32), p99, max, &rig, &paths[2])?;
     let raw = a.out.with_file_name(format!(
         "{}-displacement.raw",
         a.out.file_stem().map_or("bos".into(), |s| s.to_string_lossy())
@@ -186,9 +182,8 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
         2,
         w,
         h,
-        "BOS ground-truth displacement (dx, dy) per pixel, in pixels, x right and y down, rows top first",
+        "BOS ground-truth displacement (dx, dy) per pixel, in pixels, x right and y down, rows top first: the apparent motion of the background pattern from the reference image to the flow image (the convention of PIV/BOS software)",
     )?;
-    let m = camera.magnification();
     let background = match &a.background {
         BackgroundChoice::Random => "random dots".to_string(),
         BackgroundChoice::Grid => "a dot grid".to_string(),
@@ -198,7 +193,7 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
         format!("; Airy disc {:.2} px across", 2.0 * d.first_dark_ring())
     });
     println!(
-        "wrote {}, {}, {}, {} ({w}×{h}, {} rays in {:.2} s; f = {f} m at f/{}, Z_A = {z_a:.3} m, Z_D = {z_d:.3} m, M = {m:.4e}; background {background}{airy}; displacement max {max:.3} px, 99th percentile {p99:.3} px)",
+        "wrote {}, {}, {}, {} ({w}×{h}, {} rays in {:.2} s; f/{}, {rig}; background {background}{airy}; displacement 99th percentile {p99:.3} px, max {max:.3} px)",
         paths[0].display(),
         paths[1].display(),
         paths[2].display(),
@@ -210,26 +205,79 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The displacement as a figure: hue = direction, saturation = size up to
+/// the 99th percentile `p99` (beyond it, full colour), and its wheel.
+fn displacement_figure(
+    field: &[[f64; 2]],
+    (w, h): (u32, u32),
+    p99: f64,
+    max: f64,
+    rig: &BosRig,
+    path: &Path,
+) -> anyhow::Result<()> {
+    // A field with (almost) nothing moving: scale to the maximum, so the
+    // wheel still has a size.
+    let (rim, note) = if p99 > 1e-3 * max && p99 > 0.0 {
+        (p99, "99th percentile")
+    } else {
+        (max.max(1e-6), "maximum")
+    };
+    let wheel = FilterImage::hue_wheel(256, rim);
+    let rgb: Vec<u8> = field
+        .iter()
+        .flat_map(|d| {
+            // Clamped to the rim, so the largest 1 % keep their hue. The
+            // wheel's up is the image's −y.
+            let k = (rim / d[0].hypot(d[1])).min(1.0);
+            let c = wheel.at(k * d[0] * 0.999_999, -k * d[1] * 0.999_999);
+            c.map(|x| (rt_core::frame::linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0).round() as u8)
+        })
+        .collect();
+    let fig = Figure {
+        image: Image::from_rgb8(w, h, rgb),
+        title: "BOS displacement, reference → flow (ground truth)".into(),
+        subtitle: format!("{rig}; max {} px", significant(max)),
+        axes: None,
+        legend: Legend::DisplacementWheel { filter: wheel, rim_note: note.into() },
+    };
+    fig.write(path).with_context(|| path.display().to_string())
+}
+
 /// The BOS set-up `a` describes for `volume` (every render of `rt bos`,
-/// the demo and rtvis goes through here): the camera on the +axis side
-/// of the volume's centre looking back along −axis (light travels +axis,
-/// so the image's x runs along u as in `rt schlieren`), focused on the
-/// background `Z_D` behind the centre; dots sized in pixels as imaged, an
-/// image read from its PNG; two-cell leapfrog steps through the field.
+/// the demo and rtvis goes through here) and the rig it chose: the camera
+/// on the +axis side of the volume's centre looking back along −axis
+/// (light travels +axis, so the image's x runs along u as in `rt
+/// schlieren`), focused on the background `Z_D` behind the centre;
+/// lens, sensor and distances not given are chosen by [`BosRig::choose`]
+/// (`Z_D` from a survey of the flow's deflections); dots sized in pixels
+/// as imaged, an image read from its PNG; two-cell leapfrog steps through
+/// the field.
 ///
 /// # Errors
 /// The volume closer to the lens than its focal length, an unreadable
 /// background image, or a bad set-up.
-pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<Bos> {
+pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<(Bos, BosRig)> {
     let b = volume.bounds();
     let (axis, u) = a.axis.frame();
     let v = axis.cross(u);
     let ext = b.max - b.min;
     let w = a.size as usize;
     let h = ((f64::from(a.size) * ext.dot(v) / ext.dot(u)).round() as usize).max(1);
-    let f = a.focal_length;
-    let z_a = a.distance_or_default(volume);
-    let z_d = a.background_distance.unwrap_or(z_a);
+    let fixed = BosRigOptions {
+        focal_length: a.focal_length,
+        pixel_pitch: a.pixel,
+        camera_distance: a.distance,
+        background_distance: a.background_distance,
+    };
+    // Only a background distance left to choose needs the deflections.
+    let deflection = if a.background_distance.is_none() {
+        let survey = volume.survey(&volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0))?;
+        survey.magnitude(0.99)
+    } else {
+        0.0
+    };
+    let rig = BosRig::choose(&fixed, ext.dot(u), ext.dot(axis), w, deflection)?;
+    let (f, z_a, z_d) = (rig.focal_length, rig.camera_distance, rig.background_distance);
     if z_a <= f {
         bail!("the volume must be farther from the lens ({z_a} m) than its focal length ({f} m)");
     }
@@ -240,7 +288,7 @@ pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<Bos> {
         focal_length: f,
         f_number: a.f_number,
         focus_distance: z_a + z_d,
-        pixel_pitch: a.pixel,
+        pixel_pitch: rig.pixel_pitch,
         width: w,
         height: h,
     };
@@ -265,7 +313,7 @@ pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<Bos> {
         params: volume.params(),
     };
     bos.validate()?;
-    Ok(bos)
+    Ok((bos, rig))
 }
 
 /// What `--background` names.
@@ -290,17 +338,6 @@ fn background(s: &str) -> Result<BackgroundChoice, String> {
 }
 
 impl Args {
-    /// `--distance`, or the default: the volume's width across the image
-    /// (and a 5 % margin) fills the sensor at the volume's centre.
-    #[must_use]
-    pub fn distance_or_default(&self, volume: &impl Source) -> f64 {
-        let b = volume.bounds();
-        let (_, u) = self.axis.frame();
-        let f = self.focal_length;
-        self.distance
-            .unwrap_or(f + f * 1.05 * (b.max - b.min).dot(u) / (f64::from(self.size) * self.pixel))
-    }
-
     /// The options `rt bos FILE ARGS…` would parse to.
     ///
     /// # Errors

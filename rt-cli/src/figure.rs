@@ -99,6 +99,12 @@ impl Image {
         Self { width: f.width(), height: f.height(), rgb }
     }
 
+    /// 8-bit sRGB RGB pixels, rows top first (`w·h·3` bytes).
+    pub(crate) fn from_rgb8(width: u32, height: u32, rgb: Vec<u8>) -> Self {
+        debug_assert_eq!(rgb.len(), width as usize * height as usize * 3);
+        Self { width, height, rgb }
+    }
+
     /// The size it is shown at: its longer side in [`SHOWN`], same aspect.
     fn shown_size(&self) -> (u32, u32) {
         let long = self.width.max(self.height);
@@ -156,6 +162,15 @@ pub(crate) enum Legend {
     /// The colour filter: its transmission over the deflection disc, hue =
     /// direction, saturation = size, the rim at its half range.
     Wheel(FilterImage),
+    /// A colour wheel of a displacement field in pixels (BOS): hue =
+    /// direction, saturation = size, full at the rim (its half range);
+    /// `rim_note` says what the rim is.
+    DisplacementWheel {
+        /// The wheel.
+        filter: FilterImage,
+        /// What the rim's value is, e.g. `99th percentile`.
+        rim_note: String,
+    },
     /// A scalar's colour map over its range; `constant` draws the one
     /// colour a constant scalar was painted in.
     ColorBar {
@@ -206,7 +221,7 @@ impl Figure {
         let (left, right, top, bottom) = margins(self.axes.is_some());
         let (legend_w, legend_h) = match self.legend {
             Legend::None => (0, 0),
-            Legend::Wheel(_) => (230, 330),
+            Legend::Wheel(_) | Legend::DisplacementWheel { .. } => (230, 330),
             Legend::ColorBar { .. } => (150, 220),
         };
         let main_w = left + dw + right;
@@ -251,7 +266,31 @@ impl Figure {
                         })
                     };
                     let names = (name(&self.axes, 0), name(&self.axes, 1));
-                    wheel(&side, filter, &names, top)?;
+                    let half = filter.half_range;
+                    let texts = WheelText {
+                        title: "Deflection ε".into(),
+                        marks: (format!("+{}", names.0), format!("+{}", names.1)),
+                        lines: vec![
+                            "hue: direction of ε".into(),
+                            "saturation: size |ε|".into(),
+                            format!("rim: |ε| = {} rad", scientific(half)),
+                            "beyond the rim: black (cut)".into(),
+                        ],
+                    };
+                    wheel(&side, filter, &texts, top)?;
+                }
+                Legend::DisplacementWheel { filter, rim_note } => {
+                    let texts = WheelText {
+                        title: "Displacement Δ".into(),
+                        marks: ("+x".into(), "−y".into()),
+                        lines: vec![
+                            "hue: direction of Δ".into(),
+                            "saturation: size |Δ|".into(),
+                            format!("rim: |Δ| = {} px", significant(filter.half_range)),
+                            format!("({rim_note}; beyond: full)"),
+                        ],
+                    };
+                    wheel(&side, filter, &texts, top)?;
                 }
                 Legend::ColorBar { map, name, constant } => {
                     color_bar(&side, map, name, *constant, (top, top + dh))?;
@@ -351,19 +390,27 @@ fn scale_bar(picture: &Area<'_>, u: &Axis, pw: u32, ph: u32) -> Result<(), DrawE
     picture.draw(&Text::new(label, (cx, bar_y - pad / 2), style))
 }
 
+/// The words around a colour wheel: its title, the labels of its right
+/// and up marks, and the lines below it.
+struct WheelText {
+    title: String,
+    marks: (String, String),
+    lines: Vec<String>,
+}
+
 /// The colour filter as a disc: each point's colour is the filter's
 /// transmission at that deflection (right = `+u`, up = `+v`, the rim at
 /// its half range), with what it means written below.
 fn wheel(
     side: &Area<'_>,
     filter: &FilterImage,
-    (u_name, v_name): &(String, String),
+    texts: &WheelText,
     top: u32,
 ) -> Result<(), DrawError> {
     let (w, _) = side.dim_in_pixel();
     let cx = (w / 2) as i32 - 6;
     let centre = Pos::new(HPos::Center, VPos::Top);
-    text(side, "Deflection ε", (cx, top as i32), 16.0, w - 8, centre)?;
+    text(side, &texts.title, (cx, top as i32), 16.0, w - 8, centre)?;
     let r = 72i32;
     let cy = top as i32 + 48 + r;
     // The disc, its edge anti-aliased against the white panel.
@@ -392,21 +439,16 @@ fn wheel(
     side.draw(&PathElement::new([(cx, cy - r), (cx, cy - r - 8)], grey.stroke_width(1)))?;
     let small = |h, v| TextStyle::from((FAMILY, 14).into_font()).color(&BLACK).pos(Pos::new(h, v));
     side.draw(&Text::new(
-        format!("+{u_name}"),
+        texts.marks.0.clone(),
         (cx + r + 11, cy),
         small(HPos::Left, VPos::Center),
     ))?;
     side.draw(&Text::new(
-        format!("+{v_name}"),
+        texts.marks.1.clone(),
         (cx, cy - r - 10),
         small(HPos::Center, VPos::Bottom),
     ))?;
-    let lines = [
-        "hue: direction of ε".to_string(),
-        "saturation: size |ε|".to_string(),
-        format!("rim: |ε| = {} rad", scientific(half)),
-    ];
-    for (k, line) in lines.iter().enumerate() {
+    for (k, line) in texts.lines.iter().enumerate() {
         let at = (cx + 6, cy + r + 14 + 20 * k as i32);
         text(side, line, at, 14.0, w - 8, centre)?;
     }

@@ -5,8 +5,11 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
-use rt_photo::{Cutoff, FocusingImages, FocusingSchlieren, Mode, Sensor, SourceGrid, ThinLens};
+use anyhow::Context;
+use rt_photo::{
+    Cutoff, FocusingImages, FocusingRig, FocusingRigOptions, FocusingSchlieren, Mode, Sensor,
+    SourceGrid, ThinLens,
+};
 use rt_volume::io::{is_unstructured, read_grid};
 
 use crate::{
@@ -39,18 +42,21 @@ pub struct Args {
     /// Image width in pixels (height follows the volume's aspect).
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=8192))]
     pub size: u32,
-    /// Schlieren lens focal length in metres [default: the volume's
-    /// width across the image fills the sensor].
+    /// Schlieren lens focal length in metres [default: a quarter of
+    /// --distance, so f/2 at the default aperture].
     #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
     pub focal_length: Option<f64>,
-    /// Schlieren lens aperture diameter in metres [default: an eighth of
-    /// the distance to the volume]: larger focuses more sharply (depth of
-    /// sharp focus ≈ 2·w·Z/D for a feature of width w at distance Z).
+    /// Schlieren lens aperture diameter in metres [default: f/2, an eighth
+    /// of --distance]: larger
+    /// focuses more sharply (depth of sharp focus ≈ 2·w·Z/D for a feature
+    /// of width w at distance Z).
     #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
     pub aperture: Option<f64>,
-    /// Sensor pixel pitch in metres.
-    #[arg(long, default_value_t = 5e-6, value_parser = parse::positive, allow_hyphen_values = true)]
-    pub pixel: f64,
+    /// Pitch of a pixel in the schlieren lens's image plane (relayed to a
+    /// camera), metres [default: the volume's width and 5 % fill the
+    /// image].
+    #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
+    pub pixel: Option<f64>,
     /// Distance from the lens to the volume's centre in metres [default:
     /// twice the volume's width across the image].
     #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
@@ -65,7 +71,9 @@ pub struct Args {
     pub source_distance: Option<f64>,
     /// Source grid pitch on its plane, metres [default: from a survey of
     /// the flow, so that the strongest 1 % of deflections across the bands
-    /// use 80 % of the linear range; finer saturates them, then repeats].
+    /// use 80 % of the linear range (finer saturates them, then repeats),
+    /// kept to 25–100 periods across the aperture's view of the source
+    /// plane, so the undisturbed image is flat].
     #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
     pub pitch: Option<f64>,
     /// Bright fraction of each period of the source grid, in (0, 1).
@@ -135,7 +143,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 /// A bad set-up or an unwritable output.
 pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<FocusingImages> {
     let t = std::time::Instant::now();
-    let fs = prepare(volume, a)?;
+    let (fs, rig) = prepare(volume, a)?;
     let cam = fs.camera;
     let (w, h) = (cam.width, cam.height);
     let images = volume.focusing(&fs, a.seed)?;
@@ -168,101 +176,73 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<FocusingImages> 
     let mut sorted: Vec<f64> = relative.iter().map(|v| (v - 1.0).abs()).collect();
     sorted.sort_by(f64::total_cmp);
     let p99 = sorted[((sorted.len() - 1) as f64 * 0.99) as usize];
-    let aperture_bands = cam.aperture() * (fs.source_distance - cam.focus_distance)
-        / cam.focus_distance
-        / fs.grid.pitch;
     println!(
-        "wrote {}, {} ({w}×{h}, {} rays in {:.2} s; f = {:.4} m, aperture {:.3} m, focus {:.3} m from the lens, source grid at {:.3} m, pitch {:.3e} m ({aperture_bands:.1} periods across the aperture's view), cutoff offset {} pitch; |I/I₀ − 1| 99th percentile {p99:.3})",
+        "wrote {}, {} ({w}×{h}, {} rays in {:.2} s; {rig}; cutoff offset {} pitch; |I/I₀ − 1| 99th percentile {p99:.3})",
         a.out.display(),
         raw.with_extension("json").display(),
         w * h * (a.samples_per_axis * a.samples_per_axis) as usize,
         t.elapsed().as_secs_f64(),
-        cam.focal_length,
-        cam.aperture(),
-        cam.focus_distance,
-        fs.source_distance,
-        fs.grid.pitch,
         fs.cutoff_offset,
     );
     Ok(images)
 }
 
 /// The set-up `a` describes for `volume` (`rt focusing`, the demo and
-/// rtvis go through here): the camera on the +axis side of the volume's
-/// centre looking back along −axis (light travels +axis, so the image's
-/// x runs along u as in `rt schlieren`), focused `--focus` toward the lens
-/// from the centre; the source grid behind the volume, its pitch from a
-/// survey of the flow unless given; two-cell leapfrog steps.
+/// rtvis go through here) and the rig it chose: the camera on the +axis
+/// side of the volume's centre looking back along −axis (light travels
+/// +axis, so the image's x runs along u as in `rt schlieren`), focused
+/// `--focus` toward the lens from the centre; lens, sensor, distances and
+/// the source grid's pitch not given are chosen by [`FocusingRig::choose`]
+/// (the pitch from a survey of the flow); two-cell leapfrog steps.
 ///
 /// # Errors
 /// The focus plane closer to the lens than its focal length, the source
 /// grid not beyond it, or a bad set-up.
-pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<FocusingSchlieren> {
+pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<(FocusingSchlieren, FocusingRig)> {
     let b = volume.bounds();
     let (axis, u) = a.axis.frame();
     let v = axis.cross(u);
     let ext = b.max - b.min;
     let w = a.size as usize;
     let h = ((f64::from(a.size) * ext.dot(v) / ext.dot(u)).round() as usize).max(1);
-    let width = ext.dot(u);
-    let z = a.distance.unwrap_or(2.0 * width);
-    let z_f = z - a.focus;
-    // The magnification that fits the volume's width (and 5 %) on the
-    // sensor at its centre, M = f/(Z − f).
-    let m = f64::from(a.size) * a.pixel / (1.05 * width);
-    let f = a.focal_length.unwrap_or(m * z / (1.0 + m));
-    if z_f <= f {
-        bail!(
-            "the focus plane must be farther from the lens ({z_f} m) than its focal length ({f} m)"
-        );
-    }
-    let z_s = a.source_distance.unwrap_or(2.0 * z_f);
-    if z_s.is_nan() || z_s <= z_f {
-        bail!("the source grid ({z_s} m from the lens) must lie beyond the focus plane ({z_f} m)");
-    }
-    let aperture = a.aperture.unwrap_or(z / 8.0);
+    let angle = a.angle.to_radians();
+    let fixed = FocusingRigOptions {
+        focal_length: a.focal_length,
+        aperture: a.aperture,
+        pixel_pitch: a.pixel,
+        camera_distance: a.distance,
+        source_distance: a.source_distance,
+        grid_pitch: a.pitch,
+    };
+    // Only a pitch left to choose needs the deflections.
+    let deflection = if a.pitch.is_none() {
+        let survey = volume.survey(&volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0))?;
+        survey.along(angle, 0.99)
+    } else {
+        0.0
+    };
+    let rig = FocusingRig::choose(&fixed, ext.dot(u), w, a.focus, a.offset, deflection)?;
     let camera = ThinLens {
-        position: 0.5 * (b.min + b.max) + z * axis,
+        position: 0.5 * (b.min + b.max) + rig.camera_distance * axis,
         direction: -axis,
         up: v,
-        focal_length: f,
-        f_number: f / aperture,
-        focus_distance: z_f,
-        pixel_pitch: a.pixel,
+        focal_length: rig.focal_length,
+        f_number: rig.focal_length / rig.aperture,
+        focus_distance: rig.focus_distance,
+        pixel_pitch: rig.pixel_pitch,
         width: w,
         height: h,
     };
-    let angle = a.angle.to_radians();
-    let lever = z_s - z_f;
-    let pitch = match a.pitch {
-        Some(p) => p,
-        None => {
-            // |I/I₀ − 1| = ε·(Z_S − Z_F)/(offset·pitch) while the source
-            // points move less than the cutoff's offset; beyond, the image
-            // saturates and then repeats band by band. 0.8 for the 99th
-            // percentile of the deflection across the bands. A flow without
-            // deflections: 20 bands across the aperture's view of the
-            // source plane, D·(Z_S − Z_F)/Z_F.
-            let survey =
-                volume.survey(&volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0))?;
-            let eps = survey.along(angle, 0.99);
-            if eps > 0.0 && a.offset > 0.0 {
-                eps * lever / (0.8 * a.offset)
-            } else {
-                aperture * lever / z_f / 20.0
-            }
-        }
-    };
     let fs = FocusingSchlieren {
         camera,
-        source_distance: z_s,
-        grid: SourceGrid { pitch, duty: a.duty, angle, bands: a.bands },
+        source_distance: rig.source_distance,
+        grid: SourceGrid { pitch: rig.grid_pitch, duty: a.duty, angle, bands: a.bands },
         cutoff_offset: a.offset,
         aperture_samples: a.samples_per_axis,
         params: volume.params(),
     };
     fs.validate()?;
-    Ok(fs)
+    Ok((fs, rig))
 }
 
 impl Args {

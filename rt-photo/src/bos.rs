@@ -11,9 +11,9 @@
 //! [`Background`] (random dots, a dot grid or an image) is looked up.
 //! [`Bos::render`] returns the reference
 //! image (no flow: the rays go straight), the flow image and the ground
-//! truth users check their BOS processing against: per pixel, the mean
-//! landing point on the background minus the undisturbed one, imaged on
-//! the sensor by `M`, in pixels.
+//! truth users check their BOS processing against: per pixel, the
+//! apparent motion of the background pattern from the reference to the
+//! flow image (as PIV software reports it), in pixels.
 
 use alloc::vec::Vec;
 use core::fmt;
@@ -204,9 +204,13 @@ pub struct BosImages {
     pub reference: Vec<f64>,
     /// The background seen through the flow.
     pub flow: Vec<f64>,
-    /// Per pixel, `(Δx, Δy)` in pixels (x right, y down): where the flow
-    /// moved the background's image, the aperture-averaged landing point
-    /// on the background minus the undisturbed one, imaged by `M`.
+    /// Per pixel, `(Δx, Δy)` in pixels (x right, y down), in the
+    /// convention of PIV and BOS software: the apparent motion of the
+    /// background pattern from the reference image to the flow image, what
+    /// cross-correlating reference → flow measures. It is the opposite of
+    /// the shift of where the pixel's rays land: the undisturbed
+    /// aperture-averaged landing point on the background minus the
+    /// disturbed one, imaged by `M`.
     pub displacement: Vec<[f64; 2]>,
 }
 
@@ -405,8 +409,11 @@ impl Bos {
                 let (u1, v1) = self.on_background(&f, r.position, r.direction);
                 px.reference += self.background.value(u0, v0);
                 px.flow += self.background.value(u1, v1);
-                px.displacement[0] += (u1 - u0) * to_px;
-                px.displacement[1] -= (v1 - v0) * to_px;
+                // The pattern moves the other way from where the ray
+                // lands: flow(p) = reference(p + landing shift), so a
+                // feature at q in the reference shows at q − shift.
+                px.displacement[0] -= (u1 - u0) * to_px;
+                px.displacement[1] += (v1 - v0) * to_px;
             }
             px.reference /= n;
             px.flow /= n;

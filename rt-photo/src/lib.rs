@@ -20,7 +20,9 @@
 //! ([`Airy`]), exposure, shot and read noise, full well, bit depth.
 //! [`Bos`] renders background-oriented schlieren through a [`ThinLens`]
 //! camera: the reference and flow images of a [`Background`] (random
-//! dots, a dot grid or an image) and the ground-truth displacement.
+//! dots, a dot grid or an image) and the ground-truth displacement, in the
+//! convention of PIV/BOS software; [`BosRig::choose`] and
+//! [`FocusingRig::choose`] size a laboratory rig for a flow.
 //! [`FocusingSchlieren`] renders a lens-and-grid system focused on a
 //! plane in the flow, which it shows sharply while the rest blurs away.
 //!
@@ -92,6 +94,7 @@ mod focusing;
 mod math;
 #[cfg(feature = "mesh")]
 mod mesh;
+mod rig;
 mod sensor;
 mod sheet;
 
@@ -102,6 +105,7 @@ pub use bos::{Bos, BosError, BosImages, ThinLens};
 pub use cutoff::{Cutoff, CutoffError, CutoffParam, FilterImage};
 pub use film::{Film, FilmError, Filter, Photon};
 pub use focusing::{FocusingError, FocusingImages, FocusingSchlieren, SourceGrid};
+pub use rig::{BosRig, BosRigOptions, FocusingRig, FocusingRigOptions};
 pub use sensor::{Sensor, SensorError};
 // The types in this crate's signatures, from the crates below it (and
 // `build_octree`, the only way to the `Octree` that `render_grid` takes).

@@ -61,8 +61,13 @@ fn displacement_is_the_paraxial_relation() {
             * delta
             * (x / sigma)
             * (-(x * x) / (2.0 * sigma * sigma)).exp();
-        // Looking along +z with y up, the image's x (right) is −x.
-        let want = -m * 1.0 * eps / 5e-6;
+        // Looking along +z with y up, the image's x (right) is −x; the
+        // rays land shifted by M·Z_D·ε on the image, and the pattern
+        // appears shifted the other way. The bump is a converging lens: it
+        // magnifies the background, so the pattern moves outward.
+        let want = m * 1.0 * eps / 5e-6;
+        let outward = if i < w / 2 { -1.0 } else { 1.0 };
+        assert!(want * outward >= 0.0 || want.abs() < 1e-12, "pixel {i}: {want}");
         let got = out.displacement[i];
         assert!((got[0] - want).abs() < 0.01 * peak, "pixel {i}: Δx {} vs {want}", got[0]);
         // (Sub-pixel jitter samples ε_y about the axis: ≤ 1 % of the peak.)

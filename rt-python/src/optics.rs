@@ -216,31 +216,24 @@ pub(crate) fn bos<'py>(
         let (h, w) = view.dim();
         (w, h, view.iter().copied().collect::<Vec<f64>>())
     });
-    let (bos, images) = py
+    let (bos, rig, images) = py
         .detach(|| -> anyhow::Result<_> {
-            let mut bos = rt_cli::bos::prepare(v, &a)?;
+            let (mut bos, rig) = rt_cli::bos::prepare(v, &a)?;
             if let Some((w, h, samples)) = image {
                 let px = image_pixel.unwrap_or(bos.camera.width as f64 / w as f64);
                 bos.background =
                     ImageBackground::for_camera(&bos.camera, w, h, samples, px)?.into();
             }
             let images = v.bos(&bos, a.seed)?;
-            Ok((bos, images))
+            Ok((bos, rig, images))
         })
         .map_err(value_error)?;
     let (w, h) = (images.width, images.height);
     let c = bos.camera;
     let said = format!(
-        "f = {} m at f/{} (working f/{:.4}), Z_A = {:.4} m, Z_B = {:.4} m, M = {:.4e}, {}×{} pixels of {} m",
-        c.focal_length,
+        "f/{} (working f/{:.2}), {rig}; {w}×{h} pixels",
         c.f_number,
         c.f_number * (1.0 + c.magnification()),
-        a.distance_or_default(v),
-        bos.background_distance,
-        c.magnification(),
-        w,
-        h,
-        c.pixel_pitch
     );
     let disp: Vec<f64> = images.displacement.iter().flatten().copied().collect();
     Ok((
@@ -273,7 +266,7 @@ pub(crate) fn focusing<'py>(
     let v = &volume.inner;
     let (fs, images) = py
         .detach(|| -> anyhow::Result<_> {
-            let fs = rt_cli::focusing::prepare(v, &a)?;
+            let (fs, _) = rt_cli::focusing::prepare(v, &a)?;
             let images = v.focusing(&fs, a.seed)?;
             Ok((fs, images))
         })

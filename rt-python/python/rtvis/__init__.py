@@ -571,18 +571,21 @@ def color_schlieren(
                      photons=photons, seed=seed, deflection=deflection, dtype=dtype)
 
 
-def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_length: float = 0.1,
-        f_number: float = 16.0, pixel: float = 5e-6, distance: Optional[float] = None,
+def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_length: Optional[float] = None,
+        f_number: float = 16.0, pixel: Optional[float] = None, distance: Optional[float] = None,
         background_distance: Optional[float] = None, dot: float = 3.0, spacing: float = 4.0,
         samples: int = 2, seed: int = 1, background="random",
         background_pixel: Optional[float] = None):
     """Background-oriented schlieren of ``volume``, set up as ``rt bos``
     sets it up: a thin-lens camera (``focal_length`` and ``pixel`` pitch in
     metres, ``f_number``) at ``distance`` Z_A from the volume's centre on
-    the +``axis`` side (default: the volume fills the image width), focused
-    on a background ``background_distance`` Z_D behind the centre (default
-    Z_A); ``samples``² stratified aperture samples per pixel traced
-    backward through the field.
+    the +``axis`` side, focused on a background ``background_distance``
+    Z_D behind the centre; ``samples``² stratified aperture samples per
+    pixel traced backward through the field. What is not given is chosen
+    as a laboratory rig (``rt bos --help``): the pixel pitch of a 2048 ×
+    5.5 µm sensor binned to ``size`` pixels, the usual lens that fills the
+    image with the volume about 1.5 m away, and Z_D so that the flow's
+    99th-percentile deflection (from a quick survey) moves the image 4 px.
 
     ``background``: ``"random"`` dots or a ``"grid"`` of dots (both
     ``dot`` pixels wide, ``spacing`` pixels apart as imaged), the path of a
@@ -595,9 +598,12 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
     Returns ``(reference, flow, displacement, info)``: the background
     without and with the flow (float64 (h, w), about 0–1; record them with
     :func:`record` for a camera's counts, noise and diffraction), the
-    ground-truth displacement of the background's image, float64 (h, w, 2)
-    in pixels (x right, y down), and a line describing the set-up (with the
-    working f-number ``N·(1 + M)`` that :func:`record`'s ``airy`` wants).
+    ground-truth displacement, float64 (h, w, 2) in pixels (x right, y
+    down) in the convention of PIV/BOS software (OpenPIV, LaVision,
+    PIVlab): the apparent motion of the background pattern from the
+    reference image to the flow image, what cross-correlating reference →
+    flow measures; and a line describing the set-up (with the working
+    f-number ``N·(1 + M)`` that :func:`record`'s ``airy`` wants).
     Paraxially ``|Δ| = M·Z_D·|ε|/pitch``, ``M = f/(Z_A + Z_D − f)``.
 
     Example: ``ref, flow, disp, info = rtvis.bos(vol, background="grid")``.
@@ -606,13 +612,15 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
         raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
     args = ["--axis", _choice("axis", axis, ("x", "y", "z")),
             "--size", str(_integer("size", size, 1, 8192)),
-            "--focal-length", repr(_number("focal_length", focal_length, positive=True)),
             "--f-number", repr(_number("f_number", f_number, positive=True)),
-            "--pixel", repr(_number("pixel", pixel, positive=True)),
             "--dot", repr(_number("dot", dot, positive=True)),
             "--spacing", repr(_number("spacing", spacing, positive=True)),
             "--samples-per-axis", str(_integer("samples", samples, 1, 64)),
             "--seed", str(_integer("seed", seed, 0, 2**64 - 1))]
+    if focal_length is not None:
+        args += ["--focal-length", repr(_number("focal_length", focal_length, positive=True))]
+    if pixel is not None:
+        args += ["--pixel", repr(_number("pixel", pixel, positive=True))]
     if distance is not None:
         args += ["--distance", repr(_number("distance", distance, positive=True))]
     if background_distance is not None:
@@ -635,7 +643,7 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
 
 
 def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_length: Optional[float] = None,
-             aperture: Optional[float] = None, pixel: float = 5e-6, distance: Optional[float] = None,
+             aperture: Optional[float] = None, pixel: Optional[float] = None, distance: Optional[float] = None,
              focus: float = 0.0, source_distance: Optional[float] = None, pitch: Optional[float] = None,
              duty: float = 0.5, angle: float = 0.0, offset: float = 0.25, bands: Optional[int] = None,
              samples: int = 6, seed: int = 1):
@@ -654,12 +662,13 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
     - ``axis``: ``"x"``, ``"y"`` or ``"z"`` (default ``"z"``).
     - ``size``: image width in pixels, 1–8192 (default 512); the height
       follows the volume's aspect.
-    - ``focal_length``: the lens's focal length, > 0 (default: the
-      volume's width across the image, and 5 %, fills the sensor).
-    - ``aperture``: the lens's diameter, > 0 (default: an eighth of
-      ``distance``); larger focuses more sharply (depth of sharp focus
-      ≈ ``2·w·Z/D`` for a feature of width ``w`` at distance ``Z``).
-    - ``pixel``: sensor pixel pitch, > 0 (default 5e-6).
+    - ``focal_length``: the schlieren lens's focal length, > 0 (default: a
+      quarter of ``distance``).
+    - ``aperture``: the lens's diameter, > 0 (default: f/2); larger
+      focuses more sharply (depth of sharp focus ≈ ``2·w·Z/D`` for a
+      feature of width ``w`` at distance ``Z``).
+    - ``pixel``: pitch of a pixel in the lens's image plane (relayed to a
+      camera), > 0 (default: the volume's width and 5 % fill the image).
     - ``distance``: from the lens to the volume's centre, > 0 (default:
       twice the volume's width across the image).
     - ``focus``: the plane in focus, its distance from the volume's centre
@@ -668,8 +677,9 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
       focus plane (default: twice the focus plane's distance).
     - ``pitch``: the source grid's period on its plane, > 0 (default: from
       a survey of the flow, so that the strongest 1 % of deflections
-      across the bands use 80 % of the linear range; finer saturates
-      them, then repeats).
+      across the bands use 80 % of the linear range, finer saturating
+      them, kept to 25–100 periods across the aperture's view of the
+      source plane so the undisturbed image is flat).
     - ``duty``: bright fraction of each period, in (0, 1) (default 0.5).
     - ``angle``: band orientation (default 0: bands along the image's
       vertical, sensitive to horizontal deflection; 90: horizontal bands,
@@ -710,14 +720,14 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
         raise ValueError(f"offset must be in [0, 1) pitches (got {offset})")
     args = ["--axis", _choice("axis", axis, ("x", "y", "z")),
             "--size", str(_integer("size", size, 1, 8192)),
-            "--pixel", repr(_number("pixel", pixel, positive=True)),
             "--focus", repr(_number("focus", focus)),
             "--duty", repr(duty),
             "--angle", repr(_number("angle", angle)),
             "--offset", repr(offset),
             "--samples-per-axis", str(_integer("samples", samples, 1, 64)),
             "--seed", str(_integer("seed", seed, 0, 2**64 - 1))]
-    for name, value in (("focal_length", focal_length), ("aperture", aperture), ("distance", distance),
+    for name, value in (("focal_length", focal_length), ("aperture", aperture), ("pixel", pixel),
+                        ("distance", distance),
                         ("source_distance", source_distance), ("pitch", pitch)):
         if value is not None:
             args += ["--" + name.replace("_", "-"), repr(_number(name, value, positive=True))]
