@@ -198,7 +198,7 @@ def test_bos_displacement_is_the_paraxial_relation(gaussian):
     vol, sigma, delta = gaussian  # refractive index, 1 mm cells, σ = 8 mm
     f, pitch, z_a, z_d = 0.1, 5e-6, 2.0, 1.5
     ref, flow, disp, info = rtvis.bos(vol, size=128, distance=z_a, background_distance=z_d,
-                                      f_number=200.0, samples=2)
+                                      focal_length=f, pixel=pitch, f_number=200.0, samples=2)
     assert ref.shape == flow.shape == disp.shape[:2] == (128, 128)
     assert "f/200" in info
     m = f / (z_a + z_d - f)
@@ -209,7 +209,10 @@ def test_bos_displacement_is_the_paraxial_relation(gaussian):
     y = (64 - 64.5) * pitch / m * z_a / (z_a + z_d)
     g = np.exp(-(xs**2 + y**2) / (2 * sigma**2))
     eps = -math.sqrt(2 * math.pi) * delta * (xs / sigma) * g
-    want = m * z_d * eps / pitch  # the camera looks back along −z: x is x
+    # The camera looks back along −z (x is x); rays land shifted by
+    # M·Z_D·ε, so the background pattern appears shifted the other way
+    # (the convention of PIV software): the bump magnifies it outward.
+    want = -m * z_d * eps / pitch
     peak = np.abs(want).max()
     assert peak > 0.5
     assert np.abs(row[:, 0] - want).max() < 0.02 * peak
@@ -218,7 +221,7 @@ def test_bos_displacement_is_the_paraxial_relation(gaussian):
     ref2, flow2, disp2, _ = rtvis.bos(flat, size=16)
     assert np.abs(disp2).max() < 1e-9 and np.abs(flow2 - ref2).max() < 1e-9
     with pytest.raises(ValueError, match="farther from the lens"):
-        rtvis.bos(vol, distance=0.05)
+        rtvis.bos(vol, focal_length=0.1, distance=0.05)
     with pytest.raises(ValueError, match="f_number must be > 0"):
         rtvis.bos(vol, f_number=-1)
 

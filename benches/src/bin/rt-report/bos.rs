@@ -201,6 +201,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     };
     loglog(&plot, 900, 600, &dir.join("bos.png")).map_err(|e| e.to_string())?;
     writeln!(md, "\nwrote {}", dir.join("bos.csv").display()).unwrap();
+    openpiv_closure(dir, &mut md, &mut verdicts);
     Ok(Section {
         title: format!(
             "bos (ORACLES §7 bump, {side}² pixels, analytic or on a 96³ grid; paraxial: f/400 against Δ = M·Z_D·ε; f8: against the analytic field at 64 samples, adaptive 1e-10)"
@@ -212,4 +213,58 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             "displacement rms error (y, pixels) against seconds (x), one line per case and method over 1, 4, 16 aperture samples per pixel".into(),
         )],
     })
+}
+
+/// The closure against OpenPIV (`rt-python/examples/bos_openpiv.py`): a
+/// BOS pair of a Gaussian density bump from `rtvis.bos` and `rt bos`, with
+/// and without sensor noise, cross-correlated by OpenPIV, against rt's
+/// truth averaged over each window. Run with the Python `$RT_PYTHON`
+/// names, or CI's virtualenv (`target/venv-rtvis`) when it has rtvis and
+/// openpiv; otherwise the section says it was not run.
+fn openpiv_closure(dir: &Path, md: &mut String, verdicts: &mut Vec<String>) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let python = std::env::var_os("RT_PYTHON")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| root.join("target/venv-rtvis/bin/python"));
+    let script = root.join("rt-python/examples/bos_openpiv.py");
+    let json = dir.join("bos-openpiv.json");
+    let mut cmd = std::process::Command::new(&python);
+    cmd.arg(&script).arg("--json").arg(&json);
+    let rt = root.join("target/release/rt");
+    if rt.exists() {
+        cmd.arg("--rt").arg(&rt);
+    }
+    match cmd.output() {
+        Ok(out) if out.status.success() => {
+            let table = String::from_utf8_lossy(&out.stdout);
+            writeln!(md, "\nOpenPIV (window 32 px, overlap 16) against rt's truth averaged over each window:\n\n{table}").unwrap();
+            let rows = std::fs::read_to_string(&json).unwrap_or_default();
+            // The thresholds: same sign and shape, sub-pixel agreement.
+            let met = rows.contains("correlation")
+                && table.lines().filter(|l| l.starts_with("| rt")).all(|l| {
+                    let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+                    let corr: f64 = cells.get(3).and_then(|c| c.parse().ok()).unwrap_or(-1.0);
+                    let rms: f64 = cells.get(4).and_then(|c| c.parse().ok()).unwrap_or(9.0);
+                    corr >= 0.98 && rms <= 0.1
+                });
+            verdicts.push(format!(
+                "OpenPIV closure: correlation ≥ 0.98 and rms ≤ 0.1 px in every case → {}",
+                if met { "met" } else { "NOT met" }
+            ));
+        }
+        Ok(out) => {
+            let why = String::from_utf8_lossy(&out.stderr);
+            let last = why.lines().last().unwrap_or("no message");
+            writeln!(md, "\nOpenPIV closure: failed ({}: {last})", python.display()).unwrap();
+            verdicts.push("OpenPIV closure → NOT met (the script failed)".into());
+        }
+        Err(_) => {
+            writeln!(
+                md,
+                "\nOpenPIV closure: not run (no {}; set RT_PYTHON to a Python with rtvis and openpiv)",
+                python.display()
+            )
+            .unwrap();
+        }
+    }
 }
