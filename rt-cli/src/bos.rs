@@ -35,7 +35,7 @@ pub struct Args {
     /// Interpolation between samples (`cubic`: Catmull–Rom, a smooth
     /// gradient; `rt-report bos`: 0.004 px from the paraxial relation on a
     /// bump of 10 cells' σ, where `linear` is 0.09 px off).
-    #[arg(long, value_enum, default_value_t = Interpolation::Linear)]
+    #[arg(long, value_enum, default_value_t = Interpolation::Cubic)]
     pub interp: Interpolation,
     /// Light travels along this axis, from the background through the flow
     /// to the camera (the image axes are those of `rt schlieren`).

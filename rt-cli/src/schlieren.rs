@@ -76,7 +76,9 @@ pub struct Args {
     #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
     pub radius: Option<f64>,
     /// Colour filter half range: the deflection at the wheel's rim, in
-    /// radians [default: automatic, the 99th-percentile deflection].
+    /// radians; light deflected beyond the rim is cut and shows black
+    /// [default: automatic, the rim clears 99.5 % of the disturbed pixels
+    /// (surveyed at the image's resolution)].
     #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
     pub half_range: Option<f64>,
     /// Interferometry wavelength in metres (CO₂ laser: 10.6e-6).
@@ -111,8 +113,11 @@ pub struct Args {
     /// Monte Carlo estimate, for comparison).
     #[arg(long, value_enum, default_value_t = Estimator::Sheet)]
     pub estimator: Estimator,
-    /// Interpolation between samples (grids).
-    #[arg(long, value_enum, default_value_t = Interpolation::Linear)]
+    /// Interpolation between samples (grids): `cubic` (Catmull–Rom, C¹)
+    /// by default, as `linear`'s gradient jumps at every cell face and a
+    /// shadowgraph, which images its derivative, prints the grid as lines;
+    /// `linear` is about twice as fast.
+    #[arg(long, value_enum, default_value_t = Interpolation::Cubic)]
     pub interp: Interpolation,
     /// How an unstructured mesh is read and traced.
     #[command(flatten)]
@@ -154,7 +159,7 @@ const MAX_PHOTONS: u64 = 1 << 36;
 
 /// The cutoff or mode for `args`, its parameters chosen from `survey` where
 /// the user left them out; returns a line saying what was chosen.
-fn optics(a: &Args, survey: &Survey, n_ref: f64) -> (Mode, f64, String) {
+fn optics(a: &Args, survey: &Survey, fine: Option<&Survey>, n_ref: f64) -> (Mode, f64, String) {
     let angle = a.angle.to_radians();
     // Knife edge and graded filter: 0.5 ± 0.45 at the 99th percentile.
     let eps_perp = survey.along(angle, 0.99).max(1e-12);
@@ -180,7 +185,10 @@ fn optics(a: &Args, survey: &Survey, n_ref: f64) -> (Mode, f64, String) {
             (mode, film, format!("{what}, f = {f} m, radius = {radius:.4e} m"))
         }
         CutoffKind::Color => {
-            let half = a.half_range.unwrap_or(eps);
+            // The rim clears 99.5 % of the disturbed pixels of a survey at
+            // the image's resolution: what lies beyond it is cut (black).
+            let chosen = || fine.unwrap_or(survey).disturbed_magnitude(0.995).max(1e-12);
+            let half = a.half_range.unwrap_or_else(chosen);
             let mode = Mode::Schlieren(Cutoff::Color(FilterImage::hue_wheel(256, half)));
             (mode, film, format!("colour filter, half range = {half:.4e} rad"))
         }
@@ -231,7 +239,15 @@ pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<(Bench, String)
     }
     let survey = volume.survey(&probe)?;
     let n_ref = volume.n_ref();
-    let (mode, film_distance, chosen) = optics(a, &survey, n_ref);
+    // A colour filter's rim must clear the peaks a coarse survey smooths
+    // away: survey it at the image's resolution (up to 512 pixels across,
+    // one photon each: a fraction of the render's photons).
+    let fine = if a.cutoff == CutoffKind::Color && a.half_range.is_none() {
+        Some(volume.survey_at(&probe, (a.size as usize).min(512))?)
+    } else {
+        None
+    };
+    let (mode, film_distance, chosen) = optics(a, &survey, fine.as_ref(), n_ref);
     if let Mode::Interferometry { lambda, fringe_spacing, .. } = mode {
         // Phase step per pixel: the deflection is the phase gradient over k.
         let pixel = probe.width / f64::from(a.size);
