@@ -106,7 +106,7 @@ pub struct Args {
     #[arg(long)]
     pub airy: bool,
     /// Wavelength in metres (of --airy's diffraction).
-    #[arg(long, default_value_t = 532e-9, value_parser = parse::positive, allow_hyphen_values = true)]
+    #[arg(long, default_value = "532e-9", value_parser = parse::positive, allow_hyphen_values = true)]
     pub wavelength: f64,
     /// Seed of the dots, the samples and the noise.
     #[arg(long, default_value_t = 1)]

@@ -30,13 +30,41 @@ use rt_photo::FilterImage;
 use crate::{
     image::{WriteError, over_background, write_rgb8},
     text::{FAMILY, register_font_once, superscript},
+    units::si,
 };
 
 /// The image's longer side on the figure, in pixels.
 const SHOWN: Range<u32> = 520..1001;
 
-/// Height of the title and subtitle band.
+/// Height of the title and subtitle band (at scale 1).
 const TITLE_HEIGHT: u32 = 66;
+
+/// Text and layout grow with the image shown, so a large figure printed at
+/// a column's width keeps legible text: 1 at a 700-px image, 0.9 to 1.45
+/// over [`SHOWN`].
+#[derive(Clone, Copy, Debug)]
+struct Scale(f64);
+
+impl Scale {
+    fn for_image(long_side: u32) -> Self {
+        Self((f64::from(long_side) / 700.0).clamp(0.9, 1.45))
+    }
+
+    /// A length in pixels.
+    fn px(self, v: u32) -> u32 {
+        (f64::from(v) * self.0).round() as u32
+    }
+
+    /// A signed offset in pixels.
+    fn at(self, v: i32) -> i32 {
+        (f64::from(v) * self.0).round() as i32
+    }
+
+    /// A font size.
+    fn pt(self, v: f64) -> f64 {
+        (v * self.0).round()
+    }
+}
 
 /// Plotters' error for the bitmap backend.
 type DrawError = DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>;
@@ -206,8 +234,9 @@ fn register() -> Result<(), FigureError> {
 
 /// Margins around the image: left, right, top, bottom (the axes' ticks
 /// and labels, or a plain border).
-fn margins(axes: bool) -> (u32, u32, u32, u32) {
-    if axes { (100, 34, 12, 60) } else { (16, 16, 12, 16) }
+fn margins(axes: bool, k: Scale) -> (u32, u32, u32, u32) {
+    let (l, r, t, b) = if axes { (100, 34, 12, 60) } else { (16, 16, 12, 16) };
+    (k.px(l), k.px(r), k.px(t), k.px(b))
 }
 
 impl Figure {
@@ -218,30 +247,32 @@ impl Figure {
     pub(crate) fn write(&self, path: &Path) -> Result<(), FigureError> {
         register()?;
         let (dw, dh) = self.image.shown_size();
-        let (left, right, top, bottom) = margins(self.axes.is_some());
+        let k = Scale::for_image(dw.max(dh));
+        let (left, right, top, bottom) = margins(self.axes.is_some(), k);
         let (legend_w, legend_h) = match self.legend {
             Legend::None => (0, 0),
-            Legend::Wheel(_) | Legend::DisplacementWheel { .. } => (230, 330),
-            Legend::ColorBar { .. } => (150, 220),
+            Legend::Wheel(_) | Legend::DisplacementWheel { .. } => (k.px(230), k.px(330)),
+            Legend::ColorBar { .. } => (k.px(150), k.px(220)),
         };
         let main_w = left + dw + right;
         let width = (main_w + legend_w).max(560);
-        let height = TITLE_HEIGHT + (top + dh + bottom).max(legend_h);
+        let title_h = k.px(TITLE_HEIGHT);
+        let height = title_h + (top + dh + bottom).max(legend_h);
         let mut rgb = vec![255u8; width as usize * height as usize * 3];
         {
             let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
             root.fill(&WHITE)?;
             let centre = (width / 2) as i32;
             let title = Pos::new(HPos::Center, VPos::Top);
-            text(&root, &self.title, (centre, 10), 21.0, width - 24, title)?;
-            text(&root, &self.subtitle, (centre, 40), 15.0, width - 24, title)?;
-            let (_, body) = root.split_vertically(TITLE_HEIGHT);
+            text(&root, &self.title, (centre, k.at(10)), k.pt(21.0), width - 24, title)?;
+            text(&root, &self.subtitle, (centre, k.at(40)), k.pt(15.0), width - 24, title)?;
+            let (_, body) = root.split_vertically(title_h);
             // Any width beyond the image and legend goes to the right.
             let (main, side) = body.split_horizontally(width - legend_w);
             let (main, _) = main.split_vertically(top + dh + bottom);
             let (main, _) = main.split_horizontally(main_w);
             let (picture, (pw, ph)) = match &self.axes {
-                Some((u, v)) => draw_axes(&main, u, v, (left, right, top, bottom))?,
+                Some((u, v)) => draw_axes(&main, u, v, (left, right, top, bottom), k)?,
                 None => {
                     let area = main.margin(top, bottom, left, right);
                     let dim = area.dim_in_pixel();
@@ -255,7 +286,7 @@ impl Figure {
             let frame = RGBColor(80, 80, 80).stroke_width(1);
             picture.draw(&Rectangle::new([(0, 0), (pw as i32 - 1, ph as i32 - 1)], frame))?;
             if let Some((u, _)) = &self.axes {
-                scale_bar(&picture, u, pw, ph)?;
+                scale_bar(&picture, u, pw, ph, k)?;
             }
             match &self.legend {
                 Legend::None => {}
@@ -266,18 +297,17 @@ impl Figure {
                         })
                     };
                     let names = (name(&self.axes, 0), name(&self.axes, 1));
-                    let half = filter.half_range;
                     let texts = WheelText {
                         title: "Deflection ε".into(),
                         marks: (format!("+{}", names.0), format!("+{}", names.1)),
                         lines: vec![
                             "hue: direction of ε".into(),
                             "saturation: size |ε|".into(),
-                            format!("rim: |ε| = {} rad", scientific(half)),
+                            format!("rim: |ε| = {}", si(filter.half_range, "rad")),
                             "beyond the rim: black (cut)".into(),
                         ],
                     };
-                    wheel(&side, filter, &texts, top)?;
+                    wheel(&side, filter, &texts, top, k)?;
                 }
                 Legend::DisplacementWheel { filter, rim_note } => {
                     let texts = WheelText {
@@ -290,10 +320,10 @@ impl Figure {
                             format!("({rim_note}; beyond: full)"),
                         ],
                     };
-                    wheel(&side, filter, &texts, top)?;
+                    wheel(&side, filter, &texts, top, k)?;
                 }
                 Legend::ColorBar { map, name, constant } => {
-                    color_bar(&side, map, name, *constant, (top, top + dh))?;
+                    color_bar(&side, map, name, *constant, (top, top + dh), k)?;
                 }
             }
             root.present()?;
@@ -331,6 +361,7 @@ fn draw_axes<'a>(
     u: &Axis,
     v: &Axis,
     (left, right, top, bottom): (u32, u32, u32, u32),
+    k: Scale,
 ) -> Result<(Area<'a>, (u32, u32)), DrawError> {
     let unit = Unit::for_extent((u.range.end - u.range.start).max(v.range.end - v.range.start));
     let (u_ticks, u_step) = ticks(&u.range, 6);
@@ -338,9 +369,9 @@ fn draw_axes<'a>(
     let mut chart = ChartBuilder::on(area)
         .margin_top(top)
         .margin_right(right)
-        .margin_left(12)
+        .margin_left(k.px(12))
         .x_label_area_size(bottom)
-        .y_label_area_size(left - 12)
+        .y_label_area_size(left - k.px(12))
         .build_cartesian_2d(Ticked::new(&u.range, u_ticks), Ticked::new(&v.range, v_ticks))?;
     let u_fmt = |x: &f64| unit.format(*x, u_step);
     let v_fmt = |y: &f64| unit.format(*y, v_step);
@@ -351,8 +382,8 @@ fn draw_axes<'a>(
         .y_desc(format!("{} [{}]", v.name, unit.name))
         .x_label_formatter(&u_fmt)
         .y_label_formatter(&v_fmt)
-        .label_style((FAMILY, 15))
-        .axis_desc_style((FAMILY, 16))
+        .label_style((FAMILY, k.pt(15.0)))
+        .axis_desc_style((FAMILY, k.pt(16.0)))
         .draw()?;
     let picture = chart.plotting_area().strip_coord_spec();
     let dim = picture.dim_in_pixel();
@@ -362,7 +393,7 @@ fn draw_axes<'a>(
 /// A bar of a round length (1, 2 or 5 × 10ⁿ, 10–25 % of the width) with
 /// its length written above, on a pale box in the image's lower right
 /// corner. Left out on images under 160 px wide.
-fn scale_bar(picture: &Area<'_>, u: &Axis, pw: u32, ph: u32) -> Result<(), DrawError> {
+fn scale_bar(picture: &Area<'_>, u: &Axis, pw: u32, ph: u32, k: Scale) -> Result<(), DrawError> {
     let extent = u.range.end - u.range.start;
     if pw < 160 || ph < 60 || !(extent.is_finite() && extent > 0.0) {
         return Ok(());
@@ -371,14 +402,14 @@ fn scale_bar(picture: &Area<'_>, u: &Axis, pw: u32, ph: u32) -> Result<(), DrawE
     let bar = (length / extent * f64::from(pw)).round() as i32;
     let unit = Unit::for_extent(length);
     let label = format!("{} {}", unit.format(length, length), unit.name);
-    let style = TextStyle::from((FAMILY, 15).into_font())
+    let style = TextStyle::from((FAMILY, k.pt(15.0)).into_font())
         .color(&BLACK)
         .pos(Pos::new(HPos::Center, VPos::Bottom));
     let (tw, th) = picture.estimate_text_size(&label, &style)?;
-    let (pad, thick) = (8, 5);
+    let (pad, thick) = (k.at(8), k.at(5));
     let box_w = bar.max(tw as i32) + 2 * pad;
     let box_h = th as i32 + thick + 3 * pad;
-    let (x1, y1) = (pw as i32 - 12, ph as i32 - 12);
+    let (x1, y1) = (pw as i32 - k.at(12), ph as i32 - k.at(12));
     let (x0, y0) = (x1 - box_w, y1 - box_h);
     picture.draw(&Rectangle::new([(x0, y0), (x1, y1)], WHITE.mix(0.8).filled()))?;
     let cx = (x0 + x1) / 2;
@@ -406,13 +437,14 @@ fn wheel(
     filter: &FilterImage,
     texts: &WheelText,
     top: u32,
+    k: Scale,
 ) -> Result<(), DrawError> {
     let (w, _) = side.dim_in_pixel();
-    let cx = (w / 2) as i32 - 6;
+    let cx = (w / 2) as i32 - k.at(6);
     let centre = Pos::new(HPos::Center, VPos::Top);
-    text(side, &texts.title, (cx, top as i32), 16.0, w - 8, centre)?;
-    let r = 72i32;
-    let cy = top as i32 + 48 + r;
+    text(side, &texts.title, (cx, top as i32), k.pt(16.0), w - 8, centre)?;
+    let r = k.at(72);
+    let cy = top as i32 + k.at(48) + r;
     // The disc, its edge anti-aliased against the white panel.
     let n = 2 * r + 1;
     let mut px = Vec::with_capacity((n * n * 3) as usize);
@@ -435,22 +467,24 @@ fn wheel(
     let grey = RGBColor(110, 110, 110);
     side.draw(&Circle::new((cx, cy), r, grey.stroke_width(1)))?;
     // Direction marks: +u to the right, +v up.
-    side.draw(&PathElement::new([(cx + r, cy), (cx + r + 8, cy)], grey.stroke_width(1)))?;
-    side.draw(&PathElement::new([(cx, cy - r), (cx, cy - r - 8)], grey.stroke_width(1)))?;
-    let small = |h, v| TextStyle::from((FAMILY, 14).into_font()).color(&BLACK).pos(Pos::new(h, v));
+    let tick = k.at(8);
+    side.draw(&PathElement::new([(cx + r, cy), (cx + r + tick, cy)], grey.stroke_width(1)))?;
+    side.draw(&PathElement::new([(cx, cy - r), (cx, cy - r - tick)], grey.stroke_width(1)))?;
+    let small =
+        |h, v| TextStyle::from((FAMILY, k.pt(14.0)).into_font()).color(&BLACK).pos(Pos::new(h, v));
     side.draw(&Text::new(
         texts.marks.0.clone(),
-        (cx + r + 11, cy),
+        (cx + r + k.at(11), cy),
         small(HPos::Left, VPos::Center),
     ))?;
     side.draw(&Text::new(
         texts.marks.1.clone(),
-        (cx, cy - r - 10),
+        (cx, cy - r - k.at(10)),
         small(HPos::Center, VPos::Bottom),
     ))?;
-    for (k, line) in texts.lines.iter().enumerate() {
-        let at = (cx + 6, cy + r + 14 + 20 * k as i32);
-        text(side, line, at, 14.0, w - 8, centre)?;
+    for (i, line) in texts.lines.iter().enumerate() {
+        let at = (cx + k.at(6), cy + r + k.at(14 + 20 * i as i32));
+        text(side, line, at, k.pt(14.0), w - 8, centre)?;
     }
     Ok(())
 }
@@ -463,11 +497,12 @@ fn color_bar(
     name: &str,
     constant: bool,
     rows: (u32, u32),
+    k: Scale,
 ) -> Result<(), DrawError> {
     let (w, h) = side.dim_in_pixel();
     let (lo, hi) = map.range();
-    let bar_top = rows.0 + 30;
-    let bar_bottom = rows.1.max(bar_top + 120).min(h.saturating_sub(8));
+    let bar_top = rows.0 + k.px(30);
+    let bar_bottom = rows.1.max(bar_top + k.px(120)).min(h.saturating_sub(8));
     // A constant scalar: one value, one colour, a nominal span to draw on.
     let span = if constant || hi <= lo { (lo, lo) } else { (lo, hi) };
     let pad = if span.0 == span.1 { span.0.abs().max(1.0) } else { 0.0 };
@@ -483,10 +518,12 @@ fn color_bar(
     if exponent != 0 {
         label.push_str(&format!(" ×10{}", superscript(exponent)));
     }
-    text(side, &label, (36, rows.0 as i32), 15.0, w - 10, Pos::new(HPos::Left, VPos::Top))?;
-    let area = side.margin(bar_top, h.saturating_sub(bar_bottom), 36, 8);
+    let left = k.px(36);
+    let at = (left as i32, rows.0 as i32);
+    text(side, &label, at, k.pt(15.0), w - 10, Pos::new(HPos::Left, VPos::Top))?;
+    let area = side.margin(bar_top, h.saturating_sub(bar_bottom), left, 8);
     let mut chart = ChartBuilder::on(&area)
-        .set_label_area_size(LabelAreaPosition::Right, 70)
+        .set_label_area_size(LabelAreaPosition::Right, k.px(70))
         .build_cartesian_2d(0f64..1.0, Ticked::new(&range, key))?;
     let fmt = |y: &f64| plain(*y / scale, step / scale);
     chart
@@ -494,7 +531,7 @@ fn color_bar(
         .disable_mesh()
         .disable_x_axis()
         .y_label_formatter(&fmt)
-        .label_style((FAMILY, 14))
+        .label_style((FAMILY, k.pt(14.0)))
         .draw()?;
     let bar = chart.plotting_area().strip_coord_spec();
     let (bw, bh) = bar.dim_in_pixel();
@@ -649,15 +686,6 @@ pub(crate) fn significant(x: f64) -> String {
     }
 }
 
-/// `x` with two significant digits as `m.m×10ⁿ` (plain from 0.01 to 1000).
-fn scientific(x: f64) -> String {
-    if !x.is_finite() || x == 0.0 || (0.01..1000.0).contains(&x.abs()) {
-        return format!("{x:.3}");
-    }
-    let e = (x.abs().log10() + 1e-9).floor() as i32;
-    format!("{:.1}×10{}", x / 10f64.powi(e), superscript(e))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -685,8 +713,6 @@ mod tests {
         assert_eq!(Unit::for_extent(0.004).name, "mm");
         assert_eq!(Unit::for_extent(0.004).format(0.002, 0.0005), "2.0");
         assert_eq!(Unit::for_extent(3e-6).name, "µm");
-        assert_eq!(scientific(3.14e-4), "3.1×10⁻⁴");
-        assert_eq!(scientific(0.5), "0.500");
         assert_eq!(significant(-0.32526073), "-0.3253");
         assert_eq!(significant(1234.5678), "1235");
         assert_eq!(significant(2.5e-7), "2.500×10⁻⁷");

@@ -7,11 +7,15 @@ use rt_photo::Cell;
 use rt_photo::{Cutoff, Mode};
 use rt_surface::io::{MeshData, read_mesh};
 use rt_volume::{
-    Grid,
-    io::{is_unstructured, read_grid, read_unstructured},
+    GridSamples,
+    glam::DVec3,
+    io::{is_unstructured, read_grid_samples, read_unstructured},
 };
 
-use crate::optics::{Axis, Interpolation, MeshTrace, MeshVolume, Samples, Source, Survey, Volume};
+use crate::{
+    optics::{Axis, Interpolation, MeshTrace, MeshVolume, Samples, Source, Survey, Volume},
+    units::{index, si, sig3},
+};
 
 /// `rt info FILE`: options.
 #[derive(Debug, clap::Args)]
@@ -45,21 +49,22 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     let text = match ext.as_deref() {
         Some("obj" | "ply" | "vtp") => mesh(&a.file, &read_mesh(&a.file)?),
         // Legacy VTK holds either: try image data, then polydata.
-        Some("vtk") => match read_grid(&a.file) {
-            Ok(g) => volume(a, &g)?,
+        Some("vtk") => match read_grid_samples(&a.file) {
+            Ok(g) => volume(a, g)?,
             Err(grid_error) => match read_mesh(&a.file) {
                 Ok(m) => mesh(&a.file, &m),
                 Err(_) => return Err(grid_error.into()),
             },
         },
-        _ => volume(a, &read_grid(&a.file)?)?,
+        _ => volume(a, read_grid_samples(&a.file)?)?,
     };
     print!("{text}");
     Ok(())
 }
 
-/// `lo … hi` of the finite values, with the count of others.
-fn range(values: impl Iterator<Item = f64>) -> String {
+/// `lo … hi` of the finite values (three significant digits, or as an
+/// index with `near_one`), their mean, and how many are not finite.
+fn range(values: impl Iterator<Item = f64>, near_one: bool) -> String {
     let (mut lo, mut hi, mut sum, mut n, mut bad) = (f64::MAX, f64::MIN, 0.0, 0usize, 0usize);
     for v in values {
         if v.is_finite() {
@@ -69,42 +74,62 @@ fn range(values: impl Iterator<Item = f64>) -> String {
         }
     }
     if n == 0 {
-        return format!("no finite values ({bad} others)");
+        return format!("no finite values ({bad} NaN or infinite)");
     }
     let mean = sum / n as f64;
-    let others = if bad > 0 { format!(", {bad} not finite") } else { String::new() };
-    format!("{lo} … {hi} (mean {mean:.6}{others})")
+    let show = |x: f64| if near_one { index(x) } else { sig3(x) };
+    let others = if bad > 0 { format!(", {bad} NaN or infinite") } else { String::new() };
+    format!("{} … {} (mean {}{others})", show(lo), show(hi), show(mean))
 }
 
-fn volume(a: &Args, g: &Grid) -> anyhow::Result<String> {
-    let [nx, ny, nz] = g.dims();
-    let (o, s, b) = (g.origin(), g.spacing(), g.bounds());
+/// A point or vector in metres, three significant digits a component.
+fn metres(v: DVec3) -> String {
+    format!("({}, {}, {}) m", sig3(v.x), sig3(v.y), sig3(v.z))
+}
+
+fn volume(a: &Args, samples: GridSamples) -> anyhow::Result<String> {
+    let [nx, ny, nz] = samples.dims;
+    let blanks = samples.non_finite();
     let mut text = format!(
         "{}: volume of {nx}×{ny}×{nz} samples, cell-centred\n\
-         spacing {} × {} × {}, first sample at ({}, {}, {})\n\
-         bounds ({}, {}, {}) … ({}, {}, {})\n\
+         spacing {} × {} × {}, first sample at {}\n\
          values {}\n",
         a.file.display(),
-        s.x,
-        s.y,
-        s.z,
-        o.x,
-        o.y,
-        o.z,
-        b.min.x,
-        b.min.y,
-        b.min.z,
-        b.max.x,
-        b.max.y,
-        b.max.z,
-        range(g.data().iter().map(|&v| f64::from(v))),
+        si(samples.spacing.x, "m"),
+        si(samples.spacing.y, "m"),
+        si(samples.spacing.z, "m"),
+        metres(samples.origin),
+        range(samples.data.iter().map(|&v| f64::from(v)), false),
     );
-    let v = Volume::new(g.clone(), a.samples.quantity, a.samples.k, true, Interpolation::Linear)
+    // Blanked samples count above; the survey sees them as the median of
+    // the others (a uniform medium there).
+    let fill = median(&samples.data);
+    let (g, _) = samples.into_grid_filling(fill)?;
+    let b = g.bounds();
+    text += &format!("bounds {} … {}\n", metres(b.min), metres(b.max));
+    if blanks > 0 {
+        text += &format!(
+            "{blanks} samples are NaN or infinite: the index and the survey below take them as the median value, {}\n",
+            sig3(f64::from(fill))
+        );
+    }
+    let v = Volume::new(g, a.samples.quantity, a.samples.k, true, Interpolation::Linear)
         .context("preparing the deflection survey")?;
-    text += &format!("index {}\n", range(v.field.grid().data().iter().map(|&n| f64::from(n))));
+    text +=
+        &format!("index {}\n", range(v.field.grid().data().iter().map(|&n| f64::from(n)), true));
     let bench = v.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
     text += &survey_line(a, &v.survey(&bench)?);
     Ok(text)
+}
+
+/// The median of the finite values (1 if there are none).
+fn median(data: &[f32]) -> f32 {
+    let mut finite: Vec<f32> = data.iter().copied().filter(|v| v.is_finite()).collect();
+    if finite.is_empty() {
+        return 1.0;
+    }
+    let mid = finite.len() / 2;
+    *finite.select_nth_unstable_by(mid, f32::total_cmp).1
 }
 
 /// An unstructured grid: its cells by kind, the tetrahedra they split
@@ -120,7 +145,7 @@ fn unstructured(a: &Args) -> anyhow::Result<String> {
             Cell::Hexahedron(_) => 3,
         }] += 1;
     }
-    let coord = |k: usize| range(data.points.iter().map(move |p| p[k]));
+    let coord = |k: usize| range(data.points.iter().map(move |p| p[k]), false);
     let mut text = format!(
         "{}: unstructured mesh of {} points, {} cells ({} tetrahedra, {} pyramids, {} wedges, {} hexahedra; {} lower-dimensional cells skipped)\n\
          x {}\ny {}\nz {}\n\
@@ -139,7 +164,7 @@ fn unstructured(a: &Args) -> anyhow::Result<String> {
         data.array,
         if data.from_cells { "cell" } else { "point" },
         if data.from_cells { ", averaged to the points" } else { "" },
-        range(data.values.iter().copied()),
+        range(data.values.iter().copied(), false),
     );
     let v = MeshVolume::new(data, a.samples.quantity, a.samples.k, true, MeshTrace::Exact)
         .context("preparing the deflection survey")?;
@@ -148,7 +173,7 @@ fn unstructured(a: &Args) -> anyhow::Result<String> {
         "split into {} tetrahedra, {} boundary faces\nindex {}\n",
         m.tetrahedra().len(),
         m.boundary_faces(),
-        range(m.index().iter().copied()),
+        range(m.index().iter().copied(), true),
     );
     let bench = v.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
     text += &survey_line(a, &v.survey(&bench)?);
@@ -157,18 +182,19 @@ fn unstructured(a: &Args) -> anyhow::Result<String> {
 
 /// The survey's line of `rt info`.
 fn survey_line(a: &Args, survey: &Survey) -> String {
+    let rad = |x: f64| if x == 0.0 { "0 rad".to_string() } else { si(x, "rad") };
     format!(
-        "deflection along {} (one photon per pixel of a {}-wide survey): |ε| median {:.3e}, 99th percentile {:.3e}, max {:.3e} rad\n",
+        "deflection along {} (one photon per pixel of a {}-wide survey): |ε| median {}, 99th percentile {}, max {}\n",
         format!("{:?}", a.axis).to_lowercase(),
         survey.width,
-        survey.magnitude(0.5),
-        survey.magnitude(0.99),
-        survey.magnitude(1.0),
+        rad(survey.magnitude(0.5)),
+        rad(survey.magnitude(0.99)),
+        rad(survey.magnitude(1.0)),
     )
 }
 
 fn mesh(path: &Path, m: &MeshData) -> String {
-    let coord = |k: usize| range(m.positions.iter().map(move |p| f64::from(p[k])));
+    let coord = |k: usize| range(m.positions.iter().map(move |p| f64::from(p[k])), false);
     let mut text = format!(
         "{}: mesh of {} vertices, {} triangles\nx {}\ny {}\nz {}\nnormals: {}\n",
         path.display(),
@@ -183,7 +209,7 @@ fn mesh(path: &Path, m: &MeshData) -> String {
         text += "scalars: none\n";
     }
     for (name, values) in &m.scalars {
-        text += &format!("scalar {name}: {}\n", range(values.iter().map(|&v| f64::from(v))));
+        text += &format!("scalar {name}: {}\n", range(values.iter().map(|&v| f64::from(v)), false));
     }
     text
 }

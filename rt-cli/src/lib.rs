@@ -42,6 +42,7 @@ mod progress;
 pub mod scenes;
 pub mod schlieren;
 pub mod text;
+pub mod units;
 pub mod view;
 pub mod vtu;
 

@@ -36,7 +36,9 @@ pub struct Samples {
     #[arg(long, value_enum, default_value_t = Quantity::Density)]
     pub quantity: Quantity,
     /// Gladstone–Dale constant K in m³/kg (n = 1 + K·ρ; air at 589 nm).
-    #[arg(long, default_value_t = GLADSTONE_DALE_AIR, value_parser = crate::parse::positive, allow_hyphen_values = true)]
+    // Written out (2.26e-4, the constant's value: a test holds them
+    // equal), as clap would print 0.000226.
+    #[arg(long, default_value = "2.26e-4", value_parser = crate::parse::positive, allow_hyphen_values = true)]
     pub k: f64,
 }
 
@@ -630,6 +632,13 @@ mod tests {
         assert_eq!(full.disturbed_magnitude(0.99), corner.disturbed_magnitude(0.99));
         assert_eq!(corner.disturbed_magnitude(0.99), 99.0);
         assert_eq!(corner.magnitude(0.99), 0.0);
+    }
+
+    /// `--k`'s default is written out for `--help`; it is the constant.
+    #[test]
+    fn the_gladstone_dale_default_is_the_constant() {
+        let a = crate::schlieren::Args::from_args(std::path::Path::new("v"), [""; 0]).unwrap();
+        assert_eq!(a.samples.k, GLADSTONE_DALE_AIR);
     }
 
     #[test]

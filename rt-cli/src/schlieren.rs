@@ -17,6 +17,7 @@ use crate::{
     image,
     optics::{Axis, Interpolation, MeshOptions, Samples, Source, Survey, Volume},
     parse,
+    units::{index, si, sig3},
 };
 
 /// The optical set-up.
@@ -82,7 +83,7 @@ pub struct Args {
     #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
     pub half_range: Option<f64>,
     /// Interferometry wavelength in metres (CO₂ laser: 10.6e-6).
-    #[arg(long, default_value_t = 10.6e-6, value_parser = parse::positive, allow_hyphen_values = true)]
+    #[arg(long, default_value = "10.6e-6", value_parser = parse::positive, allow_hyphen_values = true)]
     pub lambda: f64,
     /// Interferometry fringe spacing on the film in metres [default:
     /// infinite fringe].
@@ -170,19 +171,27 @@ fn optics(a: &Args, survey: &Survey, fine: Option<&Survey>, n_ref: f64) -> (Mode
         CutoffKind::Knife => {
             let h = a.h.unwrap_or(f * eps_perp / 0.45);
             let mode = Mode::Schlieren(Cutoff::KnifeEdge { angle, offset: 0.0, f, h });
-            (mode, film, format!("knife edge at {} deg, f = {f} m, h = {h:.4e} m", a.angle))
+            let what =
+                format!("knife edge at {}°, f = {}, h = {}", sig3(a.angle), si(f, "m"), si(h, "m"));
+            (mode, film, what)
         }
         CutoffKind::Graded => {
             let width = a.h.unwrap_or(f * eps_perp / 0.45);
             let mode = Mode::Schlieren(Cutoff::Graded { angle, f, width });
-            (mode, film, format!("graded filter at {} deg, f = {f} m, h = {width:.4e} m", a.angle))
+            let what = format!(
+                "graded filter at {}°, f = {}, width = {}",
+                sig3(a.angle),
+                si(f, "m"),
+                si(width, "m")
+            );
+            (mode, film, what)
         }
         CutoffKind::Pinhole | CutoffKind::DarkField => {
             let radius = a.radius.unwrap_or(0.25 * f * eps);
             let dark_field = a.cutoff == CutoffKind::DarkField;
             let mode = Mode::Schlieren(Cutoff::Pinhole { f, radius, dark_field });
             let what = if dark_field { "dark-field stop" } else { "pinhole" };
-            (mode, film, format!("{what}, f = {f} m, radius = {radius:.4e} m"))
+            (mode, film, format!("{what}, f = {}, radius = {}", si(f, "m"), si(radius, "m")))
         }
         CutoffKind::Color => {
             // The rim clears 99.5 % of the disturbed pixels of a survey at
@@ -190,18 +199,24 @@ fn optics(a: &Args, survey: &Survey, fine: Option<&Survey>, n_ref: f64) -> (Mode
             let chosen = || fine.unwrap_or(survey).disturbed_magnitude(0.995).max(1e-12);
             let half = a.half_range.unwrap_or_else(chosen);
             let mode = Mode::Schlieren(Cutoff::Color(FilterImage::hue_wheel(256, half)));
-            (mode, film, format!("colour filter, half range = {half:.4e} rad"))
+            (mode, film, format!("colour filter, rim at |ε| = {}", si(half, "rad")))
         }
         CutoffKind::None => {
             let div = survey.divergence(0.99);
             let l = a.film_distance.unwrap_or(if div > 0.0 { 0.5 / div } else { 0.0 });
-            (Mode::Schlieren(Cutoff::None), l, format!("no cutoff, film distance = {l:.4} m"))
+            (Mode::Schlieren(Cutoff::None), l, format!("no cutoff, film distance = {}", si(l, "m")))
         }
         CutoffKind::Interferometry => {
             let mode = Mode::Interferometry { lambda: a.lambda, n_ref, fringe_spacing: a.fringes };
-            let fringes =
-                a.fringes.map_or("infinite fringe".to_string(), |s| format!("fringes {s} m"));
-            (mode, film, format!("interferometry, λ = {} m, n_ref = {n_ref}, {fringes}", a.lambda))
+            let fringes = a
+                .fringes
+                .map_or("infinite fringe".to_string(), |s| format!("fringes {} apart", si(s, "m")));
+            let what = format!(
+                "interferometry, λ = {}, n_ref = {}, {fringes}",
+                si(a.lambda, "m"),
+                index(n_ref)
+            );
+            (mode, film, what)
         }
     }
 }
@@ -372,11 +387,12 @@ impl Args {
 pub(crate) fn summary(written: &[PathBuf], film: &Film, seconds: f64, chosen: &str) -> String {
     let files: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     format!(
-        "wrote {} ({}×{}, {} photons in {seconds:.2} s, {:.2} M photons/s; {chosen})",
+        "wrote {} ({}×{}, {} photons in {}, {}; {chosen})",
         files.join(", "),
         film.width(),
         film.height(),
         film.emitted,
-        film.emitted as f64 / seconds.max(1e-9) / 1e6,
+        si(seconds, "s"),
+        si(film.emitted as f64 / seconds.max(1e-9), "photons/s"),
     )
 }

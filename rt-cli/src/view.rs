@@ -148,6 +148,14 @@ fn is_constant(lo: f32, hi: f32) -> bool {
     hi - lo <= 4.0 * f32::EPSILON * lo.abs().max(hi.abs())
 }
 
+/// How many float32 steps `[lo, hi]` spans, where that is few enough (under
+/// 256) for the colour map's bands to show; `None` for a finer range.
+fn float_steps(lo: f32, hi: f32) -> Option<u32> {
+    let step = f32::EPSILON * lo.abs().max(hi.abs());
+    let steps = f64::from(hi - lo) / f64::from(step);
+    (step > 0.0 && steps < 256.0).then(|| steps.round() as u32)
+}
+
 /// A square of `6 × radius` side facing `up` (unit), centred under
 /// `center`, its height along `up` just below `lowest`: two triangles,
 /// counter-clockwise seen from above.
@@ -203,7 +211,14 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
                     let mid = lo + 0.5 * (hi - lo);
                     (mid, mid, true)
                 }
-                (None, Some((lo, hi))) => (lo, hi, false),
+                (None, Some((lo, hi))) => {
+                    if let Some(steps) = float_steps(lo, hi) {
+                        eprintln!(
+                            "rt: warning: scalar {name} spans {lo} to {hi}, only {steps} float32 steps: its colours come in as many bands"
+                        );
+                    }
+                    (lo, hi, false)
+                }
                 // No finite value: every vertex gets the NaN colour.
                 (None, None) => (0.0, 1.0, false),
             };
@@ -294,8 +309,12 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
             Some((map, constant)) => {
                 let (lo, hi) = map.range();
                 let (lo, hi) = (significant(lo.into()), significant(hi.into()));
-                let range =
-                    if constant { format!("constant, {lo}") } else { format!("{lo} to {hi}") };
+                let steps = float_steps(map.range().0, map.range().1);
+                let range = match (constant, steps) {
+                    (true, _) => format!("constant, {lo}"),
+                    (false, Some(n)) => format!("{lo} to {hi}, only {n} float steps"),
+                    (false, None) => format!("{lo} to {hi}"),
+                };
                 let legend = Legend::ColorBar { map, name: name.to_string(), constant };
                 let cmap = o.colormap.to_possible_value().map(|v| v.get_name().to_string());
                 let cmap = cmap.unwrap_or_default();

@@ -153,8 +153,41 @@ fn info_describes_the_blast_wave() {
     assert!(o.status.success(), "{}", stderr(&o));
     let text = stdout(&o);
     assert!(text.contains("volume of 64×64×64 samples"), "{text}");
-    assert!(text.contains("spacing 0.015625 × 0.015625 × 0.015625"), "{text}");
-    assert!(text.contains("deflection along z"), "{text}");
+    // Units and three significant digits, never 0.015625 or 0.9999999999999999.
+    assert!(text.contains("spacing 15.6 mm × 15.6 mm × 15.6 mm"), "{text}");
+    assert!(text.contains("values 0.0187 … 2.85 (mean 1.00)"), "{text}");
+    assert!(text.contains("index 1.00000417 … 1.000644"), "{text}");
+    assert!(text.contains("99th percentile 1.54 mrad"), "{text}");
+}
+
+/// `rt info` counts NaN and infinite samples instead of refusing the file
+/// (which `rt schlieren` refuses, naming the first).
+#[test]
+fn info_counts_blanked_samples() {
+    let dir = scratch("info-nan");
+    let n = 8usize;
+    let mut data = vec![1.2f32; n * n * n];
+    data[5] = f32::NAN;
+    data[77] = f32::INFINITY;
+    let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(dir.join("v.raw"), bytes).unwrap();
+    std::fs::write(
+        dir.join("v.json"),
+        r#"{"file": "v.raw", "dims": [8, 8, 8], "dtype": "float32", "spacing": [0.001, 0.001, 0.001], "origin": [0, 0, 0]}"#,
+    )
+    .unwrap();
+    let json = dir.join("v.json");
+    let o = rt(&["info", json.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains("values 1.20 … 1.20 (mean 1.20, 2 NaN or infinite)"), "{text}");
+    assert!(text.contains("2 samples are NaN or infinite"), "{text}");
+    let out = dir.join("x.png");
+    fails_with(
+        &rt(&["schlieren", json.to_str().unwrap(), "--out", out.to_str().unwrap()]),
+        &["sample 5 is not finite"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// A small volume renders; the same seed gives the same bytes, and the
@@ -182,7 +215,7 @@ fn schlieren_renders_deterministically_with_its_exposure_printed() {
     let (a, b, c) = (dir.join("a.png"), dir.join("b.png"), dir.join("c.png"));
     let said = run(&a, "sheet");
     run(&b, "sheet");
-    assert!(said.contains("knife edge at 0 deg, f = 1 m, h = "), "{said}");
+    assert!(said.contains("knife edge at 0°, f = 1.00 m, h = "), "{said}");
     assert!(said.contains("48×48"), "{said}");
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     // The classic estimator is there for comparison, and differs.
@@ -208,9 +241,10 @@ fn constant_scalar_ply(dir: &Path) -> PathBuf {
     std::fs::write(
         &path,
         "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
-         property float z\nproperty float flat\nproperty float temp\nelement face 2\n\
-         property list uchar int vertex_indices\nend_header\n\
-         0 0 0 2.5 300\n1 0 0 2.5 300.00003\n1 1 0 2.5 300\n0 1 0 2.5 300.00003\n\
+         property float z\nproperty float flat\nproperty float temp\nproperty float coarse\n\
+         element face 2\nproperty list uchar int vertex_indices\nend_header\n\
+         0 0 0 2.5 300 300\n1 0 0 2.5 300.00003 300.002\n1 1 0 2.5 300 300\n\
+         0 1 0 2.5 300.00003 300.002\n\
          3 0 1 2\n3 0 2 3\n",
     )
     .unwrap();
@@ -248,6 +282,17 @@ fn view_warns_about_a_constant_scalar_and_paints_it_in_one_colour() {
         assert!(inside.len() > 100, "the square covers the view: {}", inside.len());
         assert!(inside.iter().all(|p| *p == inside[0]), "{scalar}: more than one colour");
     }
+    // A range of a few dozen float32 steps (300 to 300.002): drawn, with a
+    // warning and the figure's title saying so.
+    let out = dir.join("coarse.png");
+    let args = ["--scalar", "coarse", "--size", "64x48", "--figure", "--out"];
+    let o = rt(&[&["view", ply.to_str().unwrap()][..], &args, &[out.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("float32 steps: its colours come in as many bands"),
+        "{}",
+        stderr(&o)
+    );
     // A range given by the user is taken as it is: no warning.
     let out = dir.join("ranged.png");
     let args = ["--scalar", "flat", "--range", "0,5", "--size", "32x24", "--out"];

@@ -85,6 +85,57 @@ pub struct Grid {
     inv_spacing: DVec3,
 }
 
+/// A grid's samples as a file holds them, before [`Grid::new`]'s checks:
+/// NaN and infinite samples (blanked cells) kept, so a caller can count
+/// them or fill them ([`GridSamples::into_grid_filling`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridSamples {
+    /// Samples per axis.
+    pub dims: [usize; 3],
+    /// Centre of sample `(0, 0, 0)`.
+    pub origin: DVec3,
+    /// Distance between samples.
+    pub spacing: DVec3,
+    /// The samples, x fastest.
+    pub data: Vec<f32>,
+}
+
+impl GridSamples {
+    /// How many samples are NaN or infinite.
+    #[must_use]
+    pub fn non_finite(&self) -> usize {
+        self.data.iter().filter(|v| !v.is_finite()).count()
+    }
+
+    /// The grid, as [`Grid::new`] makes it.
+    ///
+    /// # Errors
+    /// As [`Grid::new`] (a non-finite sample is [`GridError::NonFinite`]).
+    pub fn into_grid(self) -> Result<Grid, GridError> {
+        Grid::new(self.dims, self.origin, self.spacing, self.data)
+    }
+
+    /// The grid with every NaN or infinite sample replaced by `fill`
+    /// (blanked cells as a uniform medium), and how many were.
+    ///
+    /// # Errors
+    /// As [`Grid::new`], and [`GridError::NonFinite`] if `fill` is not
+    /// finite.
+    pub fn into_grid_filling(mut self, fill: f32) -> Result<(Grid, usize), GridError> {
+        if !fill.is_finite() {
+            return Err(GridError::NonFinite { index: usize::MAX });
+        }
+        let mut count = 0;
+        for v in &mut self.data {
+            if !v.is_finite() {
+                *v = fill;
+                count += 1;
+            }
+        }
+        Ok((self.into_grid()?, count))
+    }
+}
+
 impl Grid {
     /// The largest sample count accepted (2³¹, 8 GiB of `f32`).
     pub const MAX_SAMPLES: usize = 1 << 31;

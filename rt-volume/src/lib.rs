@@ -85,7 +85,7 @@ pub use analytic::{
 pub use brick::{BrickError, BrickField, GridInfo, IndexBounds};
 pub use field::{Bounds, IndexField};
 #[cfg(feature = "alloc")]
-pub use grid::{Grid, GridError, GridField, Interp};
+pub use grid::{Grid, GridError, GridField, GridSamples, Interp};
 pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
 #[cfg(feature = "mesh")]
 pub use mesh::{Cell, MeshError, SmoothField, UnstructuredField};

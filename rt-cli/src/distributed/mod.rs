@@ -117,7 +117,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Interpolation::Cubic)]
     pub interp: Interpolation,
     /// Volume, interferometry: wavelength in metres.
-    #[arg(long, default_value_t = 10.6e-6, value_parser = parse::positive)]
+    #[arg(long, default_value = "10.6e-6", value_parser = parse::positive)]
     pub lambda: f64,
     /// Volume, interferometry: carrier fringe spacing in metres (0:
     /// infinite fringe).

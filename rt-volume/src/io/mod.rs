@@ -5,7 +5,8 @@
 //! `UNSTRUCTURED_GRID` and XML `.vtu`, as points, linear volume cells
 //! ([`Cell`](crate::Cell)) and one scalar per point.
 //! Every malformed, truncated or oversized input is an `Err` naming the
-//! problem; samples that are NaN or infinite are rejected.
+//! problem; samples that are NaN or infinite are rejected, unless read
+//! with [`read_grid_samples`], which keeps them to be counted or filled.
 //!
 //! For bricks of volumes larger than memory: [`read_grid_info`] reads a
 //! raw + JSON or NRRD header alone, [`read_grid_box`] a box of samples,
@@ -31,7 +32,7 @@ pub use raw_json::{parse_raw_json, read_raw_json, read_raw_json_box, read_raw_js
 pub use unstructured::{UnstructuredData, is_unstructured, read_unstructured};
 pub use vtk::read_vtk;
 
-use crate::{Grid, GridInfo};
+use crate::{Grid, GridInfo, GridSamples};
 
 /// The bytes of `path`; an error names it.
 fn read(path: &Path) -> Result<Vec<u8>, ReadError> {
@@ -53,6 +54,22 @@ pub fn read_grid(path: &Path) -> Result<Grid, ReadError> {
         Some("json") => read_raw_json(path),
         Some("raw") => read_raw_json(&path.with_extension("json")),
         Some("vtk" | "vti") => read_vtk(path),
+        _ => Err(ReadError::from(ReadErrorKind::UnknownFormat).in_file(path)),
+    }
+}
+
+/// [`read_grid`]'s samples before the grid's checks: NaN and infinite
+/// samples kept, for a caller that counts them (`rt info`) or fills them
+/// ([`GridSamples::into_grid_filling`]).
+///
+/// # Errors
+/// As [`read_grid`], less the non-finite samples.
+pub fn read_grid_samples(path: &Path) -> Result<GridSamples, ReadError> {
+    match extension(path).as_deref() {
+        Some("nrrd" | "nhdr") => nrrd::read_nrrd_samples(path),
+        Some("json") => raw_json::read_raw_json_samples(path),
+        Some("raw") => raw_json::read_raw_json_samples(&path.with_extension("json")),
+        Some("vtk" | "vti") => vtk::read_vtk_samples(path),
         _ => Err(ReadError::from(ReadErrorKind::UnknownFormat).in_file(path)),
     }
 }

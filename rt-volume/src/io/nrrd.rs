@@ -16,7 +16,7 @@ use super::{
     read,
     sub_box::{Payload, read_box, read_header},
 };
-use crate::{Grid, GridInfo};
+use crate::{Grid, GridInfo, GridSamples};
 
 /// Reads a NRRD file (`NRRD0001`–`NRRD0005`, 3-D, raw encoding, attached or
 /// detached data). Geometry: `spacings` (or `space directions` that are
@@ -29,10 +29,18 @@ use crate::{Grid, GridInfo};
 /// # Errors
 /// [`ReadError`] naming the problem.
 pub fn read_nrrd(path: &Path) -> Result<Grid, ReadError> {
+    read_nrrd_samples(path)?.into_grid().map_err(|e| ReadError::from(e).in_file(path))
+}
+
+/// [`read_nrrd`]'s samples before the grid's checks (NaN kept).
+///
+/// # Errors
+/// [`ReadError`] naming the problem.
+pub(super) fn read_nrrd_samples(path: &Path) -> Result<GridSamples, ReadError> {
     let (h, _) = read_header_of(path)?;
     sample_count(h.dims).map_err(|e| e.in_file(path))?;
     let bytes = read(path)?;
-    parse_nrrd(&bytes, path.parent()).map_err(|e| e.in_file(path))
+    parse_nrrd_samples(&bytes, path.parent()).map_err(|e| e.in_file(path))
 }
 
 /// `nx·ny·nz`, at most [`Grid::MAX_SAMPLES`].
@@ -49,6 +57,11 @@ fn sample_count(dims: [usize; 3]) -> Result<usize, ReadError> {
 /// # Errors
 /// [`ReadError`] naming the problem.
 pub fn parse_nrrd(bytes: &[u8], dir: Option<&Path>) -> Result<Grid, ReadError> {
+    Ok(parse_nrrd_samples(bytes, dir)?.into_grid()?)
+}
+
+/// [`parse_nrrd`]'s samples before the grid's checks (NaN kept).
+fn parse_nrrd_samples(bytes: &[u8], dir: Option<&Path>) -> Result<GridSamples, ReadError> {
     if !bytes.starts_with(b"NRRD000") {
         return Err(malformed("not a NRRD file (magic)"));
     }
@@ -71,7 +84,7 @@ pub fn parse_nrrd(bytes: &[u8], dir: Option<&Path>) -> Result<Grid, ReadError> {
         None => payload,
     };
     let data = decode(payload, h.ty, h.little, count)?;
-    Ok(Grid::new(dims, h.origin, h.spacing, data)?)
+    Ok(GridSamples { dims, origin: h.origin, spacing: h.spacing, data })
 }
 
 /// What a NRRD header says.

@@ -12,7 +12,7 @@ use super::{
     read,
     sub_box::{Payload, read_box},
 };
-use crate::{Grid, GridInfo};
+use crate::{Grid, GridInfo, GridSamples};
 
 /// Reads raw samples described by a JSON header such as the project's
 /// sidecar: `dims` `[nx, ny, nz]`, `dtype` (`float32`, `float64`, `uint8`,
@@ -22,6 +22,14 @@ use crate::{Grid, GridInfo};
 /// # Errors
 /// [`ReadError`] naming the problem.
 pub fn read_raw_json(json_path: &Path) -> Result<Grid, ReadError> {
+    read_raw_json_samples(json_path)?.into_grid().map_err(|e| ReadError::from(e).in_file(json_path))
+}
+
+/// [`read_raw_json`]'s samples before the grid's checks (NaN kept).
+///
+/// # Errors
+/// [`ReadError`] naming the problem.
+pub(super) fn read_raw_json_samples(json_path: &Path) -> Result<GridSamples, ReadError> {
     let text = read(json_path)?;
     let header = || -> Result<(serde_json::Value, Vec<u8>), ReadError> {
         let v: serde_json::Value =
@@ -37,7 +45,9 @@ pub fn read_raw_json(json_path: &Path) -> Result<Grid, ReadError> {
         let payload = read(&dir.join(file))?;
         Ok((v, payload))
     };
-    header().and_then(|(v, payload)| parse_raw_json(&v, &payload)).map_err(|e| e.in_file(json_path))
+    header()
+        .and_then(|(v, payload)| parse_raw_json_samples(&v, &payload))
+        .map_err(|e| e.in_file(json_path))
 }
 
 /// What a raw + JSON header says.
@@ -90,6 +100,11 @@ fn header(v: &serde_json::Value) -> Result<Header, ReadError> {
 /// # Errors
 /// [`ReadError`] naming the problem.
 pub fn parse_raw_json(v: &serde_json::Value, payload: &[u8]) -> Result<Grid, ReadError> {
+    Ok(parse_raw_json_samples(v, payload)?.into_grid()?)
+}
+
+/// [`parse_raw_json`]'s samples before the grid's checks (NaN kept).
+fn parse_raw_json_samples(v: &serde_json::Value, payload: &[u8]) -> Result<GridSamples, ReadError> {
     let h = header(v)?;
     let dims = h.dims;
     let count = dims[0]
@@ -98,7 +113,7 @@ pub fn parse_raw_json(v: &serde_json::Value, payload: &[u8]) -> Result<Grid, Rea
         .filter(|&x| x <= Grid::MAX_SAMPLES)
         .ok_or(ReadError::from(ReadErrorKind::TooLarge))?;
     let data = decode(payload, h.ty, h.little, count)?;
-    Ok(Grid::new(dims, h.origin, h.spacing, data)?)
+    Ok(GridSamples { dims, origin: h.origin, spacing: h.spacing, data })
 }
 
 /// The samples `lo ≤ (i, j, k) < hi` of a raw + JSON volume, read without

@@ -12,7 +12,7 @@ use super::{
     legacy_scan::check_legacy_sizes,
     xml_scan::prepare_xml,
 };
-use crate::Grid;
+use crate::{Grid, GridSamples};
 
 /// Reads VTK image data (legacy `STRUCTURED_POINTS` or XML `ImageData`,
 /// `.vtk`/`.vti`) with the `vtkio` crate: the first point-data array
@@ -23,10 +23,18 @@ use crate::Grid;
 /// [`ReadError`] naming the problem: unreadable or malformed files, other
 /// data set types, compressed XML payloads, no point data.
 pub fn read_vtk(path: &Path) -> Result<Grid, ReadError> {
+    read_vtk_samples(path)?.into_grid().map_err(|e| ReadError::from(e).in_file(path))
+}
+
+/// [`read_vtk`]'s samples before the grid's checks (NaN kept).
+///
+/// # Errors
+/// As [`read_vtk`].
+pub(super) fn read_vtk_samples(path: &Path) -> Result<GridSamples, ReadError> {
     vtk_grid(path).map_err(|e| e.in_file(path))
 }
 
-fn vtk_grid(path: &Path) -> Result<Grid, ReadError> {
+fn vtk_grid(path: &Path) -> Result<GridSamples, ReadError> {
     use vtkio::model::{Attribute, DataSet, Extent};
     let to_read_error = |e| match e {
         vtkio::Error::IO(io) => ReadError::from(ReadErrorKind::Io(io)),
@@ -77,5 +85,5 @@ fn vtk_grid(path: &Path) -> Result<Grid, ReadError> {
     let values =
         if components > 1 { values.iter().step_by(components).copied().collect() } else { values };
     let f = |a: [f32; 3]| DVec3::new(f64::from(a[0]), f64::from(a[1]), f64::from(a[2]));
-    Ok(Grid::new(dims, f(origin), f(spacing), values)?)
+    Ok(GridSamples { dims, origin: f(origin), spacing: f(spacing), data: values })
 }
