@@ -17,6 +17,7 @@ use crate::{
     figure::{Figure, Image, Legend, significant},
     image,
     optics::{Axis, Interpolation, MeshOptions, Samples, Source, Volume},
+    output::Outputs,
     parse,
 };
 
@@ -144,6 +145,20 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 /// A bad set-up or an unwritable output.
 pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     let t = std::time::Instant::now();
+    Outputs::refuse_folder(&a.out)?;
+    let paths = [
+        image::beside(&a.out, "reference"),
+        image::beside(&a.out, "flow"),
+        image::beside(&a.out, "displacement"),
+    ];
+    let raw = a.out.with_file_name(format!(
+        "{}-displacement.raw",
+        a.out.file_stem().map_or("bos".into(), |s| s.to_string_lossy())
+    ));
+    // Before any work: an impossible --out fails now, not after the render.
+    let mut targets = paths.to_vec();
+    targets.extend([raw.clone(), raw.with_extension("json")]);
+    let outs = Outputs::check(&targets)?;
     let (bos, rig) = prepare(volume, a)?;
     let camera = bos.camera;
     let (w, h) = (camera.width, camera.height);
@@ -159,24 +174,18 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     let (w32, h32) = (w as u32, h as u32);
     let reference = sensor.record(&images.reference, w, h, a.seed)?;
     let flow = sensor.record(&images.flow, w, h, a.seed.wrapping_add(1))?;
-    let paths = [
-        image::beside(&a.out, "reference"),
-        image::beside(&a.out, "flow"),
-        image::beside(&a.out, "displacement"),
-    ];
-    image::write_counts(&reference, a.bits, w32, h32, &paths[0])?;
-    image::write_counts(&flow, a.bits, w32, h32, &paths[1])?;
+    image::write_counts(&reference, a.bits, w32, h32, &outs.staging(&paths[0]))?;
+    image::write_counts(&flow, a.bits, w32, h32, &outs.staging(&paths[1]))?;
     let mut sorted: Vec<f64> = images.displacement.iter().map(|d| d[0].hypot(d[1])).collect();
     sorted.sort_by(f64::total_cmp);
     let max = sorted.last().copied().unwrap_or(0.0);
     let p99 = sorted[((sorted.len() - 1) as f64 * 0.99) as usize];
-    displacement_figure(&images.displacement, (w32, h32), p99, max, &rig, &paths[2])?;
-    let raw = a.out.with_file_name(format!(
-        "{}-displacement.raw",
-        a.out.file_stem().map_or("bos".into(), |s| s.to_string_lossy())
-    ));
+    let figure = outs.staging(&paths[2]);
+    displacement_figure(&images.displacement, (w32, h32), p99, max, &rig, &figure)
+        .with_context(|| paths[2].display().to_string())?;
     let flat: Vec<f64> = images.displacement.iter().flatten().copied().collect();
     image::write_raw_f32(
+        &outs,
         &raw,
         &flat,
         2,
@@ -184,6 +193,7 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
         h,
         "BOS ground-truth displacement (dx, dy) per pixel, in pixels, x right and y down, rows top first: the apparent motion of the background pattern from the reference image to the flow image (the convention of PIV/BOS software)",
     )?;
+    outs.commit()?;
     let background = match &a.background {
         BackgroundChoice::Random => "random dots".to_string(),
         BackgroundChoice::Grid => "a dot grid".to_string(),
@@ -240,7 +250,7 @@ fn displacement_figure(
         axes: None,
         legend: Legend::DisplacementWheel { filter: wheel, rim_note: note.into() },
     };
-    fig.write(path).with_context(|| path.display().to_string())
+    Ok(fig.write(path)?)
 }
 
 /// The BOS set-up `a` describes for `volume` (every render of `rt bos`,

@@ -15,6 +15,7 @@ use rt_volume::io::{is_unstructured, read_grid};
 use crate::{
     image,
     optics::{Axis, Interpolation, MeshOptions, Samples, Source, Volume},
+    output::Outputs,
     parse,
 };
 
@@ -143,6 +144,9 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 /// A bad set-up or an unwritable output.
 pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<FocusingImages> {
     let t = std::time::Instant::now();
+    let raw = a.out.with_extension("raw");
+    // Before any work: an impossible --out fails now, not after the render.
+    let outs = Outputs::check(&[a.out.clone(), raw.clone(), raw.with_extension("json")])?;
     let (fs, rig) = prepare(volume, a)?;
     let cam = fs.camera;
     let (w, h) = (cam.width, cam.height);
@@ -163,9 +167,9 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<FocusingImages> 
         airy: None,
     };
     let counts = sensor.record(&light, w, h, a.seed)?;
-    image::write_counts(&counts, a.bits, w as u32, h as u32, &a.out)?;
-    let raw = a.out.with_extension("raw");
+    image::write_counts(&counts, a.bits, w as u32, h as u32, &outs.staging(&a.out))?;
     image::write_raw_f32(
+        &outs,
         &raw,
         &relative,
         1,
@@ -173,6 +177,7 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<FocusingImages> 
         h,
         "focusing schlieren: I/I0 per pixel (1 = undisturbed, and where the source lights nothing), rows top first",
     )?;
+    outs.commit()?;
     let mut sorted: Vec<f64> = relative.iter().map(|v| (v - 1.0).abs()).collect();
     sorted.sort_by(f64::total_cmp);
     let p99 = sorted[((sorted.len() - 1) as f64 * 0.99) as usize];

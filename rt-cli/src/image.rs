@@ -326,12 +326,14 @@ fn srgb_to_linear(c: f64) -> f64 {
 
 /// Writes `data` (`components` values per pixel, `width × height` pixels,
 /// rows top first) as raw little-endian float32 with a JSON sidecar
-/// beside it (`rt`'s raw + JSON format): `description` says what the
-/// values are.
+/// beside it (`rt`'s raw + JSON format), both staged in `outs` (which
+/// must hold `raw` and its `.json`): `description` says what the values
+/// are.
 ///
 /// # Errors
 /// An unwritable path, or `data` not `components × width × height` long.
 pub fn write_raw_f32(
+    outs: &crate::output::Outputs,
     raw: &Path,
     data: &[f64],
     components: usize,
@@ -342,11 +344,8 @@ pub fn write_raw_f32(
     if data.len() != components * width * height {
         bail!("{}: {} values for {width}×{height}×{components}", raw.display(), data.len());
     }
-    if let Some(dir) = raw.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
-    }
     let bytes: Vec<u8> = data.iter().flat_map(|&x| (x as f32).to_le_bytes()).collect();
-    std::fs::write(raw, bytes).with_context(|| raw.display().to_string())?;
+    std::fs::write(outs.staging(raw), bytes).with_context(|| raw.display().to_string())?;
     let json = serde_json::json!({
         "dims": [width, height],
         "components": components,
@@ -356,7 +355,7 @@ pub fn write_raw_f32(
         "description": description,
     });
     let path = raw.with_extension("json");
-    std::fs::write(&path, serde_json::to_string_pretty(&json)?)
+    std::fs::write(outs.staging(&path), serde_json::to_string_pretty(&json)?)
         .with_context(|| path.display().to_string())?;
     Ok(())
 }

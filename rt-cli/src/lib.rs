@@ -37,6 +37,7 @@ pub mod focusing;
 pub mod image;
 pub mod info;
 pub mod optics;
+pub mod output;
 mod parse;
 mod progress;
 pub mod scenes;

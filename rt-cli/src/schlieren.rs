@@ -16,6 +16,7 @@ use crate::{
     figure::{self, Figure, Legend},
     image,
     optics::{Axis, Interpolation, MeshOptions, Samples, Source, Survey, Volume},
+    output::Outputs,
     parse,
     units::{index, si, sig3},
 };
@@ -284,6 +285,15 @@ pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<(Bench, String)
 /// # Errors
 /// Bad optics, too many photons, an unwritable output.
 pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
+    let mut targets = vec![a.out.clone()];
+    if a.raw16 {
+        targets.push(image::beside(&a.out, "16bit"));
+    }
+    if !a.no_figure {
+        targets.push(image::beside(&a.out, "figure"));
+    }
+    // Before any work: an impossible --out fails now, not after the render.
+    let outs = Outputs::check(&targets)?;
     let (bench, chosen) = prepare(volume, a)?;
     let bench = match a.estimator {
         Estimator::Sheet => bench,
@@ -292,20 +302,19 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     let (film, seconds) = volume.render(&bench, a.size as usize, a.photons, a.seed)?;
     let scale = if matches!(bench.mode, Mode::Schlieren(Cutoff::None)) { 0.5 } else { 1.0 };
     let frame = image::film_frame(&film, scale)?;
-    image::write_png(&frame, &a.out)?;
-    let mut written = vec![a.out.clone()];
+    image::write_png(&frame, &outs.staging(&a.out))?;
     if a.raw16 {
-        let path = image::beside(&a.out, "16bit");
         let color = matches!(bench.mode, Mode::Schlieren(Cutoff::Color(_)));
-        image::write_film16(&film, color, &path)?;
-        written.push(path);
+        image::write_film16(&film, color, &outs.staging(&image::beside(&a.out, "16bit")))?;
     }
     if !a.no_figure {
         let path = image::beside(&a.out, "figure");
-        figure(volume, a, &bench, &frame, &chosen).write(&path)?;
-        written.push(path);
+        figure(volume, a, &bench, &frame, &chosen)
+            .write(&outs.staging(&path))
+            .with_context(|| path.display().to_string())?;
     }
-    println!("{}", summary(&written, &film, seconds, &chosen));
+    outs.commit()?;
+    println!("{}", summary(&targets, &film, seconds, &chosen));
     Ok(())
 }
 

@@ -13,6 +13,7 @@ use rt_surface::{
 use crate::{
     figure::{Figure, Image, Legend, significant},
     image::{beside, over_background, write_png},
+    output::Outputs,
     parse, progress,
 };
 
@@ -175,6 +176,13 @@ fn ground_plane(center: Vec3, radius: f32, up: Vec3, lowest: f32) -> Result<Mesh
 /// camera, an unwritable output.
 pub fn run(o: &Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
+    let out = o.out.clone().unwrap_or_else(|| o.file.with_extension("png"));
+    let mut targets = vec![out.clone()];
+    if o.figure {
+        targets.push(beside(&out, "figure"));
+    }
+    // Before any work: an impossible --out fails now, not after the render.
+    let outs = Outputs::check(&targets)?;
     let mut data = read_mesh(&o.file)?;
     if o.flat {
         data.normals = None;
@@ -296,8 +304,7 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
     if let Some((top, bottom)) = o.background.colors() {
         over_background(&mut frame, top, bottom);
     }
-    let out = o.out.clone().unwrap_or_else(|| o.file.with_extension("png"));
-    write_png(&frame, &out)?;
+    write_png(&frame, &outs.staging(&out))?;
     let mut written = out.display().to_string();
     if o.figure {
         let path = beside(&out, "figure");
@@ -329,9 +336,10 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
             axes: None,
             legend,
         };
-        figure.write(&path)?;
+        figure.write(&outs.staging(&path)).with_context(|| path.display().to_string())?;
         written = format!("{written}, {}", path.display());
     }
+    outs.commit()?;
     let c = renderer.counts();
     let seconds = rendered.as_secs_f64();
     println!(

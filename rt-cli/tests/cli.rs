@@ -160,6 +160,41 @@ fn info_describes_the_blast_wave() {
     assert!(text.contains("99th percentile 1.54 mrad"), "{text}");
 }
 
+/// An impossible `--out` is refused before the work (a folder, a path
+/// through a file), with one line naming it and nothing written; a missing
+/// folder is made and said.
+#[test]
+fn outputs_are_checked_before_the_work() {
+    let dir = scratch("outputs");
+    let vol = bump_volume(&dir, false);
+    std::fs::write(dir.join("a-file"), b"").unwrap();
+    for (sub, extra) in [("schlieren", vec!["--size", "8"]), ("bos", vec!["--size", "8"])] {
+        for (out, why) in
+            [(dir.join("a-file/x.png"), "is not a folder"), (dir.clone(), "is a folder")]
+        {
+            let mut args = vec![sub, vol.to_str().unwrap(), "--out", out.to_str().unwrap()];
+            args.extend_from_slice(&extra);
+            fails_with(&rt(&args), &[why]);
+        }
+    }
+    let out = dir.join("made/here/s.png");
+    let o = rt(&[
+        "schlieren",
+        vol.to_str().unwrap(),
+        "--size",
+        "8",
+        "--no-figure",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("created folder"), "{}", stderr(&o));
+    let names: Vec<_> =
+        std::fs::read_dir(out.parent().unwrap()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("s.png")], "no staging file left");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// `rt info` counts NaN and infinite samples instead of refusing the file
 /// (which `rt schlieren` refuses, naming the first).
 #[test]

@@ -360,7 +360,7 @@ impl fmt::Display for FocusingRig {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "schlieren lens f = {:.0} mm at f/{:.1} (D = {:.1} mm), Z = {:.3} m, focus {:.3} m, source grid at {:.3} m, pitch {:.3} mm ({:.0} periods across the view{}); image plane {} px of {:.1} µm",
+            "schlieren lens f = {:.0} mm at f/{:.1} (D = {:.1} mm), Z = {:.3} m, focus {:.3} m, source grid at {:.3} m, pitch {:.3} mm ({:.0} periods across the view{}); image plane {} px of {:.3} mm",
             self.focal_length * 1e3,
             self.focal_length / self.aperture,
             self.aperture * 1e3,
@@ -371,7 +371,7 @@ impl fmt::Display for FocusingRig {
             self.periods_in_view(),
             if self.limited { ", at its limit" } else { "" },
             self.pixels,
-            self.pixel_pitch * 1e6,
+            self.pixel_pitch * 1e3,
         )
     }
 }

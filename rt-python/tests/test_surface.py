@@ -123,3 +123,15 @@ def test_to_srgb8():
     assert out[0, 0].tolist() == [0, 0, 0]
     assert out[0, 1].tolist() == [188, 188, 188]  # sRGB(0.5) = 0.7354
     assert out[0, 2].tolist() == [255, 0, 0]
+
+
+def test_save_png_makes_its_folder_and_refuses_a_folder(tmp_path, capsys):
+    img = np.zeros((2, 3, 3), dtype=np.uint8)
+    target = tmp_path / "new" / "deeper" / "a.png"
+    rtvis.save_png(target, img)
+    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "created folder" in capsys.readouterr().err
+    with pytest.raises(IsADirectoryError, match="is a folder"):
+        rtvis.save_png(tmp_path / "new", img)
+    # Nothing but the image is left in the folder (no staging file).
+    assert [p.name for p in target.parent.iterdir()] == ["a.png"]

@@ -47,6 +47,7 @@ use rt_surface::{
 
 use crate::{
     image::{over_background, write_png},
+    output::Outputs,
     scenes,
 };
 
@@ -117,7 +118,8 @@ fn build_world(mesh: Mesh) -> anyhow::Result<SurfaceScene<'static>> {
 /// An unwritable folder or file.
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let out = a.dir.as_path();
-    std::fs::create_dir_all(out).with_context(|| out.display().to_string())?;
+    // The folder made (and said) and checked before any work.
+    let outs = Outputs::check(&[out.join("surface.png")])?;
     let mesh = terrain()?;
     // The terrain as a file, to try `rt view` on.
     let ply = out.join("terrain.ply");
@@ -159,7 +161,8 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     over_background(&mut frame, [1.0; 3], [1.0; 3]);
     let c = renderer.counts();
     let path = out.join("surface.png");
-    write_png(&frame, &path)?;
+    write_png(&frame, &outs.staging(&path))?;
+    outs.commit()?;
     println!(
         "wrote {} ({WIDTH}×{HEIGHT}, {} triangles + glyphs + tube; {PASSES} passes, AO 8; build {:.0} ms, render {:.0} ms; rays: {} primary, {} shadow, {} AO, {} reflection)",
         path.display(),

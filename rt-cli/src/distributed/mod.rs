@@ -43,6 +43,7 @@ use rt_photo::Film;
 use crate::{
     image::{film_frame, write_png},
     optics::{Interpolation, Samples},
+    output::Outputs,
     parse,
 };
 
@@ -253,11 +254,11 @@ fn rank_main<C: Communicator>(comm: &C, o: &Args) -> anyhow::Result<Option<Image
 }
 
 /// Rank 0's check against the whole data rendered in one process.
-fn check(image: &Image, o: &Args) -> anyhow::Result<()> {
+fn check(image: &Image, o: &Args, outs: Outputs) -> anyhow::Result<()> {
     let out = o.out();
     let (differ, covered, size) = match image {
         Image::Surface(composited) => {
-            write_png(composited, &out)?;
+            write_png(composited, &outs.staging(&out))?;
             let whole = surface::single(&o.surface_job())?;
             let bits = |p: &Pixel| (p.color.map(f32::to_bits), p.depth.to_bits());
             let differ = composited
@@ -270,7 +271,7 @@ fn check(image: &Image, o: &Args) -> anyhow::Result<()> {
             (differ, covered, (composited.width(), composited.height()))
         }
         Image::Volume(film, job) => {
-            write_png(&film_frame(film, 1.0)?, &out)?;
+            write_png(&film_frame(film, 1.0)?, &outs.staging(&out))?;
             let whole = volume::single(job)?;
             let differ = if volume::same(film, &whole) {
                 0
@@ -286,6 +287,7 @@ fn check(image: &Image, o: &Args) -> anyhow::Result<()> {
             (differ, film.width() * film.height(), (size(film.width()), size(film.height())))
         }
     };
+    outs.commit()?;
     println!(
         "wrote {}: {}×{}, {covered} pixels covered; differs from the single-process render in {differ} pixels (compared bit for bit)",
         out.display(),
@@ -313,7 +315,19 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
         rt_composite::mpi::initialize().ok_or_else(|| anyhow!("MPI was already initialised"))?;
     let world = universe.world();
     let comm = MpiComm::new(&world, std::time::Duration::from_secs_f64(o.timeout));
-    let result = rank_main(&comm, o).and_then(|f| f.map_or(Ok(()), |f| check(&f, o)));
+    // Rank 0 writes: its --out is checked before the work, and every rank
+    // learns the answer first, so none starts work rank 0 will not join.
+    let outs = if comm.rank() == 0 { Some(Outputs::check(&[o.out()])) } else { None };
+    let mut writable = u8::from(outs.as_ref().is_none_or(Result::is_ok));
+    rt_composite::mpi::traits::Root::broadcast_into(&world.process_at_rank(0), &mut writable);
+    let result = match outs {
+        Some(Err(e)) => Err(e),
+        _ if writable == 0 => Err(anyhow!("rank 0 cannot write {}", o.out().display())),
+        Some(Ok(outs)) => {
+            rank_main(&comm, o).and_then(|f| f.map_or(Ok(()), |f| check(&f, o, outs)))
+        }
+        None => rank_main(&comm, o).map(drop),
+    };
     std::fs::remove_dir_all(scratch(comm.rank())).ok();
     // Every rank learns whether rank 0's check passed.
     let mut ok = u8::from(result.is_ok());
@@ -333,6 +347,8 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
 #[cfg(not(feature = "mpi"))]
 pub fn run(o: &Args) -> anyhow::Result<()> {
     use rt_composite::ThreadComm;
+    // Before any work: an impossible --out fails now, not after the render.
+    let outs = Outputs::check(&[o.out()])?;
     let comms = ThreadComm::group(o.ranks as usize, std::time::Duration::from_secs_f64(o.timeout));
     let results: Vec<anyhow::Result<Option<Image>>> = std::thread::scope(|s| {
         let handles: Vec<_> =
@@ -344,7 +360,7 @@ pub fn run(o: &Args) -> anyhow::Result<()> {
     });
     let checked = results.into_iter().collect::<anyhow::Result<Vec<_>>>().and_then(|images| {
         let image = images.into_iter().flatten().next();
-        check(&image.ok_or_else(|| anyhow!("no rank returned the image"))?, o)
+        check(&image.ok_or_else(|| anyhow!("no rank returned the image"))?, o, outs)
     });
     for rank in 0..o.ranks as usize {
         std::fs::remove_dir_all(scratch(rank)).ok();

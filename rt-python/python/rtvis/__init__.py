@@ -1136,9 +1136,22 @@ def save_png(path, image) -> None:
     """Writes an 8-bit image, ``uint8`` (h, w) grey, (h, w, 3) RGB or
     (h, w, 4) RGBA, as a PNG (no other package needed). Convert first:
     :func:`to_srgb8` for surfaces, :func:`to_gray8` for optics images,
-    ``to_gray8``/``np.clip(... * 255)`` for your own."""
-    import os
+    ``to_gray8``/``np.clip(... * 255)`` for your own.
 
+    As ``rt`` does with ``--out``: a missing folder is created (and said
+    on stderr), a path that is a folder raises ``IsADirectoryError``
+    before anything is encoded, and the file appears whole or not at all
+    (written beside it, then moved into place)."""
+    import os
+    import sys
+
+    path = os.fspath(path)
+    if os.path.isdir(path):
+        raise IsADirectoryError(f"{path}: is a folder; give a file name (e.g. {os.path.join(path, 'image.png')})")
+    folder = os.path.dirname(path)
+    if folder and not os.path.isdir(folder):
+        os.makedirs(folder)
+        print(f"rtvis: created folder {folder}", file=sys.stderr)
     a = np.asarray(image)
     if a.dtype != np.uint8:
         raise TypeError(f"image: expected uint8 (convert with to_srgb8 or to_gray8), got dtype {a.dtype}")
@@ -1155,5 +1168,11 @@ def save_png(path, image) -> None:
 
     png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, color, 0, 0, 0))
            + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6)) + chunk(b"IEND", b""))
-    with open(os.fspath(path), "wb") as f:
-        f.write(png)
+    staging = os.path.join(folder, f".{os.path.basename(path)}.rt-partial")
+    try:
+        with open(staging, "wb") as f:
+            f.write(png)
+        os.replace(staging, path)
+    finally:
+        if os.path.exists(staging):
+            os.remove(staging)
