@@ -19,6 +19,7 @@ use crate::{
     optics::{Axis, Interpolation, MeshOptions, Samples, Source, Volume},
     output::Outputs,
     parse,
+    units::si,
 };
 
 /// `rt bos FILE`: options.
@@ -181,7 +182,7 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     let max = sorted.last().copied().unwrap_or(0.0);
     let p99 = sorted[((sorted.len() - 1) as f64 * 0.99) as usize];
     let figure = outs.staging(&paths[2]);
-    displacement_figure(&images.displacement, (w32, h32), p99, max, &rig, &figure)
+    displacement_figure(&images.displacement, (w32, h32), p99, max, (&rig, a.f_number), &figure)
         .with_context(|| paths[2].display().to_string())?;
     let flat: Vec<f64> = images.displacement.iter().flatten().copied().collect();
     image::write_raw_f32(
@@ -222,7 +223,7 @@ fn displacement_figure(
     (w, h): (u32, u32),
     p99: f64,
     max: f64,
-    rig: &BosRig,
+    (rig, f_number): (&BosRig, f64),
     path: &Path,
 ) -> anyhow::Result<()> {
     // A field with (almost) nothing moving: scale to the maximum, so the
@@ -246,7 +247,15 @@ fn displacement_figure(
     let fig = Figure {
         image: Image::from_rgb8(w, h, rgb),
         title: "BOS displacement, reference → flow (ground truth)".into(),
-        subtitle: format!("{rig}; max {} px", significant(max)),
+        subtitle: format!(
+            "f = {} at f/{}, Z_A = {}, Z_D = {}, pixels of {}; |Δ| up to {} px",
+            si(rig.focal_length, "m"),
+            f_number,
+            si(rig.camera_distance, "m"),
+            si(rig.background_distance, "m"),
+            si(rig.pixel_pitch, "m"),
+            significant(max)
+        ),
         axes: None,
         legend: Legend::DisplacementWheel { filter: wheel, rim_note: note.into() },
     };
