@@ -392,20 +392,22 @@ fn split_cells(
 
 /// Appends the mean of the points `ids` (sorted: the sums do not depend
 /// on the order a cell lists them in) and of their values; its index.
+/// Each term is divided before it is added, so finite points and values
+/// have a finite mean however large.
 fn add_centre(
     points: &mut Vec<DVec3>,
     index: &mut Vec<f64>,
     centres: &mut Centres,
     ids: &[u32],
 ) -> u32 {
+    let count = ids.len() as f64;
     let (mut p, mut n) = (DVec3::ZERO, 0.0);
     for &i in ids {
-        p += points[i as usize];
-        n += index[i as usize];
+        p += points[i as usize] / count;
+        n += index[i as usize] / count;
     }
-    let count = ids.len() as f64;
-    points.push(p / count);
-    index.push(n / count);
+    points.push(p);
+    index.push(n);
     centres.corners.extend_from_slice(ids);
     centres.start.push(centres.corners.len() as u32);
     (points.len() - 1) as u32
