@@ -408,7 +408,8 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             ));
         }
     }
-    // Exact against smooth at equal time.
+    // Exact against smooth at equal time: what `rt schlieren --mesh`
+    // defaults to (the faster to converge).
     for r in rows.iter().filter(|r| r.method == "tet-smooth") {
         let secs = r.seconds.best();
         if let Some((exact, outside)) = mean_error_at(&rows, "tet-exact", secs) {
@@ -440,7 +441,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     }
     writeln!(
         md,
-        "\nExact reference: {rays} rays through the analytic bump (Dormand–Prince, tolerance 1e-13) in {exact_secs:.2} s. Orders: the mean error is the steady measure; the max error moves with where the worst ray falls in its cell; pixel means (8 × 8 rays over 0.625σ) are second order only once the cells are smaller than the pixels (N ≥ 16). The meshes are split into 24 tetrahedra per hexahedron about face and cell centres (no preferred direction); tet-smooth, second order per ray, reaches a given error sooner than tet-exact, first order (see the equal-time verdicts). Grid samples are `f32` (what `Grid` stores): `n = 1 + 1e-4·g` rounds by up to 6e-8 per sample (6e-4 of δ), a random walk of about √N · 6e-8 in the deflection (~3e-3 of the peak at N = 64), which is where grid-cubic stops converging; the meshes hold `f64`.\n\nwrote {}, {}",
+        "\nExact reference: {rays} rays through the analytic bump (Dormand–Prince, tolerance 1e-13) in {exact_secs:.2} s. Orders: the mean error is the steady measure; the max error moves with where the worst ray falls in its cell; pixel means (8 × 8 rays over 0.625σ) are second order only once the cells are smaller than the pixels (N ≥ 16). The meshes are split into 24 tetrahedra per hexahedron about face and cell centres (no preferred direction); tet-smooth, second order per ray, reaches a given error sooner than tet-exact, first order (see the equal-time verdicts), which is why it is `rt schlieren --mesh`'s and `rtvis`'s default. Grid samples are `f32` (what `Grid` stores): `n = 1 + 1e-4·g` rounds by up to 6e-8 per sample (6e-4 of δ), a random walk of about √N · 6e-8 in the deflection (~3e-3 of the peak at N = 64), which is where grid-cubic stops converging; the meshes hold `f64`.\n\nwrote {}, {}",
         dir.join("unstructured.csv").display(),
         dir.join("unstructured_detail.csv").display()
     )
