@@ -152,9 +152,8 @@ pub fn knife_bench(params: TraceParams, strata: u32) -> Bench {
 
 /// The box `[lo, hi]` cut into `n³` hexahedra (VTK order) on a regular
 /// lattice of `(n + 1)³` points, the point numbering shuffled with `seed`
-/// (Fisher–Yates, SplitMix64). Hexahedra are split into tetrahedra along
-/// the diagonals through their lowest-numbered points, so the shuffle
-/// makes the diagonals vary from cell to cell as in a real mesh's file.
+/// (Fisher–Yates, SplitMix64), as scattered as in a real mesh's file (the
+/// split into tetrahedra does not depend on the numbering).
 ///
 /// # Panics
 /// If `n` is zero or the points overflow `u32`.

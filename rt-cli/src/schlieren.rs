@@ -49,7 +49,7 @@ pub struct Args {
     /// The volume: NRRD (.nrrd/.nhdr), raw + JSON sidecar (.json/.raw),
     /// VTK image data (.vtk/.vti), or an unstructured mesh (.vtu, or a
     /// legacy .vtk UNSTRUCTURED_GRID: tetrahedra, pyramids, wedges,
-    /// hexahedra), traced exactly cell by cell.
+    /// hexahedra), traced as `--mesh` says.
     pub file: PathBuf,
     /// What the samples are.
     #[command(flatten)]

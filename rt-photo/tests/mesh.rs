@@ -52,17 +52,20 @@ fn max_diff(a: &[f32], b: &[f32]) -> f64 {
     a.iter().zip(b).map(|(x, y)| f64::from((x - y).abs())).fold(0.0, f64::max)
 }
 
-/// A Gaussian bump (ORACLES §5) sampled on grids of 13 and 25 points a
+/// A Gaussian bump (ORACLES §5) sampled on grids of 7, 13 and 25 points a
 /// side: the knife-edge images from the trilinear grid and from the mesh's
-/// tetrahedra differ by what the two interpolants do (at second order in
-/// the spacing, pixels being larger than cells), and each is close to the
-/// image of the exact bump.
+/// tetrahedra differ by what the two interpolants do, at second order in
+/// the spacing while that difference is above the grid's `f32` samples'
+/// noise. Measured: 0.024, 0.0078, 0.0061 (0.0035 at 49 points; with 64
+/// photons a pixel on the sheet 0.0021, 0.0014, 0.0011 at 13, 25, 49: the
+/// floor). The split of 6 tetrahedra per hexahedron gave 0.033 and 0.0077
+/// at 13 and 25.
 #[test]
 fn grid_and_its_tetrahedra_give_the_same_image() {
     let bump = |p: DVec3| 1.0 + 1e-4 * (-p.length_squared() / 2.0).exp();
     let b = bench(knife(2000.0), 3);
     let mut diffs = Vec::new();
-    for n in [13, 25] {
+    for n in [7, 13, 25] {
         let (grid, mesh) = (grid(n, &bump), mesh(n, -3.0, 3.0, &bump));
         let params = rt_photo::TraceParams::for_grid(&grid);
         let gb = rt_photo::Bench { params, ..b.clone() };
@@ -72,7 +75,7 @@ fn grid_and_its_tetrahedra_give_the_same_image() {
         assert!(contrast > 0.2, "the bump shows: contrast {contrast}");
         diffs.push(max_diff(&g, &m));
     }
-    assert!(diffs[1] < 0.02, "{diffs:?}");
+    assert!(diffs[1] < 0.012 && diffs[2] < 0.01, "{diffs:?}");
     assert!(diffs[0] / diffs[1] > 2.5, "second order: {diffs:?}");
 }
 

@@ -44,7 +44,11 @@ fn linear_index_is_the_catenary_on_every_mesh() {
             let index = linear(&points, n0, g);
             let field = UnstructuredField::new(points, &cells, index, 1.0)
                 .unwrap_or_else(|e| panic!("{kind:?} {dims:?} jitter {jitter}: {e}"));
-            assert_eq!(field.boundary_faces(), box_boundary_triangles(dims), "{kind:?} {dims:?}");
+            assert_eq!(
+                field.boundary_faces(),
+                box_boundary_triangles(dims, kind),
+                "{kind:?} {dims:?}"
+            );
             for _ in 0..20 {
                 let (y0, z0) = (rng.range(-0.9, 0.0), rng.range(-0.9, 0.9));
                 let r = field.trace(DVec3::new(-1.0, y0, z0), DVec3::X).unwrap();
@@ -199,7 +203,8 @@ fn rays_cross_holes_and_gaps_straight() {
     let index =
         linear(&points.iter().map(|p| DVec3::new(0.0, p.x, 0.0)).collect::<Vec<_>>(), 1.5, 0.01);
     let holed = UnstructuredField::new(points.clone(), &keep, index.clone(), 1.2).unwrap();
-    assert_eq!(holed.boundary_faces(), box_boundary_triangles([4, 4, 4]) + 4 * 6 * 2);
+    // The cavity's walls: 6 × 4 grid faces, 4 triangles each.
+    assert_eq!(holed.boundary_faces(), box_boundary_triangles([4, 4, 4], Kind::Hex) + 6 * 4 * 4);
     // The same ray through the full mesh with the cavity's cells filled in
     // with ... the ambient index is not linear there, so compare the
     // pieces instead: uniform index, straight everywhere, the cavity's
@@ -301,15 +306,16 @@ fn bad_meshes_are_errors() {
         matches!(got, Some(MeshError::Inverted { cell: 0 } | MeshError::Degenerate { cell: 0 })),
         "{got:?}"
     );
-    assert!(
-        UnstructuredField::new(
-            cube,
-            &[Cell::Hexahedron([0, 1, 2, 3, 4, 5, 6, 7])],
-            vec![1.0; 8],
-            1.0
-        )
-        .is_ok()
+    // A corner pushed through the cell, past its centre: the tetrahedra
+    // at that corner turn inside out.
+    let mut pushed = cube.clone();
+    pushed[6] = DVec3::splat(0.25);
+    let hex = Cell::Hexahedron([0, 1, 2, 3, 4, 5, 6, 7]);
+    assert_eq!(
+        UnstructuredField::new(pushed, &[hex], vec![1.0; 8], 1.0).err(),
+        Some(MeshError::Inverted { cell: 0 })
     );
+    assert!(UnstructuredField::new(cube, &[hex], vec![1.0; 8], 1.0).is_ok());
     // Bad rays.
     let field = UnstructuredField::new(p, &[tet], n, 1.0).unwrap();
     for (o, d) in
@@ -406,8 +412,8 @@ fn smooth_option_converges_at_second_order_per_ray() {
         smooth_errors.push(es / 60.0);
         exact_errors.push(ee / 60.0);
     }
-    // Measured: 0.342, 0.116, 0.033 (and 0.0081 at 64: ratios 2.95, 3.52,
-    // 4.07), against the exact tracer's 0.229, 0.114, 0.062, 0.029.
+    // Measured: 0.331, 0.107, 0.029 (and 0.0073 at 64: ratios 3.10, 3.74,
+    // 3.93), against the exact tracer's 0.219, 0.112, 0.063, 0.030.
     let ratios = [smooth_errors[0] / smooth_errors[1], smooth_errors[1] / smooth_errors[2]];
     assert!(
         ratios[0] >= 2.5 && ratios[1] >= 3.2,
@@ -438,7 +444,8 @@ fn smooth_option_recovers_linear_fields_exactly() {
 }
 
 /// A structured lattice's hexahedra: `(n−1)³` cells whose split meets face
-/// to face (the boundary is the box's, two triangles per lattice face).
+/// to face (the boundary is the box's, four triangles per lattice face),
+/// 24 tetrahedra each, with a point added per cell and per face.
 #[test]
 fn lattice_hexahedra_tile_the_box() {
     let dims = [4, 3, 5];
@@ -455,6 +462,17 @@ fn lattice_hexahedra_tile_the_box() {
     }
     let n = points.len();
     let field = UnstructuredField::new(points, &cells, vec![1.0; n], 1.0).unwrap();
-    assert_eq!(field.boundary_faces(), box_boundary_triangles([3, 2, 4]));
-    assert_eq!(field.tetrahedra().len(), 6 * cells.len());
+    assert_eq!(field.boundary_faces(), box_boundary_triangles([3, 2, 4], Kind::Hex));
+    assert_eq!(field.tetrahedra().len(), 24 * cells.len());
+    // Faces: 4 planes of 2 × 4 across x, 3 of 3 × 4 across y, 5 of 3 × 2
+    // across z.
+    let faces = 4 * 2 * 4 + 3 * 3 * 4 + 5 * 3 * 2;
+    assert_eq!(field.points().len(), n);
+    assert_eq!(field.split_points().len(), n + faces + cells.len());
+    // The added points are the means of the faces' and cells' corners, and
+    // carry the means of their values: a field linear in space stays so.
+    for p in &field.split_points()[n..] {
+        let doubled = *p * 2.0;
+        assert_eq!(doubled, doubled.round(), "{p}: a face or cell centre of the unit lattice");
+    }
 }

@@ -30,8 +30,8 @@
 //!   true displacement in pixels); and focusing schlieren as `rt
 //!   focusing` writes it: `focusing.png` (a lens-and-grid system focused
 //!   on the blast's mid-plane, + `.json`/`.raw`: I/I₀ per pixel); and the
-//!   blast wave as an unstructured mesh (every second sample, 32³ points,
-//!   31³ hexahedra): `blast.vtu`, and `schlieren-mesh.png` (+ `-figure.png`)
+//!   blast wave as an unstructured mesh (2 × 2 × 2 block means, 32³
+//!   points, 31³ hexahedra): `blast.vtu`, and `schlieren-mesh.png` (+ `-figure.png`)
 //!   rendered from it as `rt schlieren blast.vtu --mesh smooth` does.
 mod optics;
 

@@ -274,19 +274,22 @@ class Mesh:
         Density (kg/m³) or refractive index at each point.
     quantity, k, allow_nonphysical
         As for :class:`Volume`.
-    trace : "exact" or "smooth"
-        ``exact``: through the data's piecewise-linear interpolant, cell by
-        cell in closed form; ``smooth``: gradients recovered at the points
-        and integrated (second order per ray, no facets on coarse meshes).
+    trace : "smooth" or "exact"
+        ``smooth`` (the default: it reaches a given error sooner): gradients
+        recovered at the points and integrated (second order per ray, no
+        facets on coarse meshes); ``exact``: through the data's
+        piecewise-linear interpolant, cell by cell in closed form (first
+        order per ray).
 
-    Cells are split into tetrahedra (neighbours meet face to face); bad
+    Cells are split into tetrahedra about their face and cell centres (24
+    per hexahedron; no preferred direction; neighbours meet face to face); bad
     meshes (NaN, zero-volume or inverted cells, indices out of range, a
     face shared by three cells) raise ``ValueError`` naming the cell. The
     index outside the mesh is that of its first point.
     """
 
     def __init__(self, points, cells, values, quantity: str = "density",
-                 k: float = GLADSTONE_DALE_AIR, trace: str = "exact",
+                 k: float = GLADSTONE_DALE_AIR, trace: str = "smooth",
                  allow_nonphysical: bool = False):
         pts = _array("points", points, 2, np.float64, last=3)
         vals = _array("values", values, 1, np.float64)
@@ -337,7 +340,7 @@ def read_mesh(
     array: Optional[str] = None,
     quantity: str = "density",
     k: float = GLADSTONE_DALE_AIR,
-    trace: str = "exact",
+    trace: str = "smooth",
     allow_nonphysical: bool = False,
 ) -> Mesh:
     """Reads an unstructured mesh: VTK XML ``.vtu`` or legacy ``.vtk``

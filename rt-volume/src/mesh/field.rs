@@ -18,16 +18,23 @@ pub(crate) const FACE: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1
 /// A refractive-index field on an unstructured mesh: `n` given at the
 /// points and linear inside each tetrahedron, so `∇n` is constant per
 /// tetrahedron and continuous `n` crosses every face. Cells other than
-/// tetrahedra are split (see [`Cell`]); rays are traced through it cell by
-/// cell in closed form ([`UnstructuredField::trace`]).
+/// tetrahedra are split, with points added at the centres of
+/// quadrilateral faces and of hexahedra and wedges (see [`Cell`]); rays
+/// are traced through it cell by cell in closed form
+/// ([`UnstructuredField::trace`]).
 ///
 /// Outside the mesh (beyond its boundary faces, including holes and the
 /// gaps of a non-convex mesh) the index is [`UnstructuredField::ambient`].
 #[derive(Clone, Debug)]
 pub struct UnstructuredField {
+    /// The input points, then the centre points the split adds.
     pub(crate) points: Vec<DVec3>,
     /// `n` at each point.
     pub(crate) index: Vec<f64>,
+    /// How many of `points` are the input's.
+    pub(crate) inputs: usize,
+    /// The corners each added point is the centre of.
+    pub(crate) centres: Centres,
     /// Point indices of each tetrahedron, ordered so its volume is positive.
     pub(crate) tets: Vec<[u32; 4]>,
     /// The input cell each tetrahedron comes from.
@@ -53,6 +60,22 @@ pub struct UnstructuredField {
     /// the plane section it lies in (< π·diameter), and moves at
     /// `ds/dt = n ≥` the cell's smallest `n`; `4·diameter/n_min`, rounded up.
     pub(crate) reach: Vec<f32>,
+}
+
+/// The corners of the points the split adds, point `inputs + i` the mean
+/// of `corners[start[i]..start[i + 1]]` (a quadrilateral's 4, a wedge's 6,
+/// a hexahedron's 8), each list sorted.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Centres {
+    pub(crate) start: Vec<u32>,
+    pub(crate) corners: Vec<u32>,
+}
+
+impl Centres {
+    /// The corners of added point `i` (counted from the first added).
+    pub(crate) fn of(&self, i: usize) -> &[u32] {
+        &self.corners[self.start[i] as usize..self.start[i + 1] as usize]
+    }
 }
 
 /// The face's normal `(p_b − p_a) × (p_c − p_a)` for its points sorted by
@@ -81,7 +104,10 @@ impl UnstructuredField {
     /// `ambient` is the index outside the mesh.
     ///
     /// A tetrahedron's points may come in either orientation; a split cell
-    /// must not fold (all its tetrahedra the same orientation).
+    /// must not fold (all its tetrahedra the same orientation). The split
+    /// adds points (see [`Cell`]), with the means of their corners' values;
+    /// [`UnstructuredField::points`] and [`UnstructuredField::index`] stay
+    /// the input's.
     ///
     /// # Errors
     /// [`MeshError`] naming the first offending point or cell: no cells,
@@ -90,9 +116,9 @@ impl UnstructuredField {
     /// a point used twice by a cell, zero-volume, folded or overlapping
     /// cells, a face shared by more than two cells, sizes past `u32`.
     pub fn new(
-        points: Vec<DVec3>,
+        mut points: Vec<DVec3>,
         cells: &[Cell],
-        index: Vec<f64>,
+        mut index: Vec<f64>,
         ambient: f64,
     ) -> Result<Self, MeshError> {
         if cells.is_empty() {
@@ -113,7 +139,10 @@ impl UnstructuredField {
         if let Some(point) = index.iter().position(|n| !(n.is_finite() && *n > 0.0)) {
             return Err(MeshError::BadValue { point });
         }
-        let (tets, cell_of) = split_cells(&points, cells)?;
+        let inputs = points.len();
+        let range =
+            index.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &n| (lo.min(n), hi.max(n)));
+        let (tets, cell_of, centres) = split_cells(&mut points, &mut index, cells)?;
         let (neighbors, flips, boundary) = adjacency(&points, &tets, &cell_of)?;
         let gradients = tets
             .iter()
@@ -125,8 +154,6 @@ impl UnstructuredField {
         );
         let shift = 0.5 * (bounds.min + bounds.max);
         let bvh = boundary_bvh(&points, &tets, &boundary, shift)?;
-        let range =
-            index.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &n| (lo.min(n), hi.max(n)));
         let reach = tets
             .iter()
             .map(|t| {
@@ -140,6 +167,8 @@ impl UnstructuredField {
         Ok(Self {
             points,
             index,
+            inputs,
+            centres,
             tets,
             cell_of,
             neighbors,
@@ -173,19 +202,28 @@ impl UnstructuredField {
         Self::new(points, cells, index, ambient)
     }
 
-    /// The points.
+    /// The points, as given.
     #[must_use]
     pub fn points(&self) -> &[DVec3] {
+        &self.points[..self.inputs]
+    }
+
+    /// `n` at each point, as given.
+    #[must_use]
+    pub fn index(&self) -> &[f64] {
+        &self.index[..self.inputs]
+    }
+
+    /// The points the tetrahedra are made of: the input points
+    /// ([`UnstructuredField::points`]), then the centre points the split
+    /// adds (see [`Cell`]).
+    #[must_use]
+    pub fn split_points(&self) -> &[DVec3] {
         &self.points
     }
 
-    /// `n` at each point.
-    #[must_use]
-    pub fn index(&self) -> &[f64] {
-        &self.index
-    }
-
-    /// The tetrahedra, as point indices (positive orientation).
+    /// The tetrahedra, as indices into [`UnstructuredField::split_points`]
+    /// (positive orientation).
     #[must_use]
     pub fn tetrahedra(&self) -> &[[u32; 4]] {
         &self.tets
@@ -245,44 +283,134 @@ impl UnstructuredField {
     }
 }
 
-/// Splits every cell, checks it, and orients its tetrahedra positively.
-fn split_cells(points: &[DVec3], cells: &[Cell]) -> Result<(Vec<[u32; 4]>, Vec<u32>), MeshError> {
+/// The split's tetrahedra and the cell each comes from, and its points.
+type Split = (Vec<[u32; 4]>, Vec<u32>, Centres);
+
+/// Splits every cell, checks it, and orients its tetrahedra positively;
+/// the points it adds (and their values) are appended to `points` and
+/// `index`.
+fn split_cells(
+    points: &mut Vec<DVec3>,
+    index: &mut Vec<f64>,
+    cells: &[Cell],
+) -> Result<Split, MeshError> {
+    // The cells before the first with a bad point index are split (their
+    // errors come first); that cell's error comes after.
+    let mut bad_index = None;
+    for (c, cell) in cells.iter().enumerate() {
+        let ids = cell.points();
+        if let Some(&index) = ids.iter().find(|&&i| i as usize >= points.len()) {
+            bad_index = Some((c, MeshError::IndexOutOfRange { cell: c, index }));
+            break;
+        }
+        if ids.iter().enumerate().any(|(k, i)| ids[..k].contains(i)) {
+            bad_index = Some((c, MeshError::RepeatedPoint { cell: c }));
+            break;
+        }
+    }
+    let cells = &cells[..bad_index.map_or(cells.len(), |(c, _)| c)];
     let total: usize = cells.iter().map(Cell::tet_count).sum();
     if total >= NONE as usize {
         return Err(MeshError::TooLarge);
     }
+    // One centre per quadrilateral face, found by its sorted points: the
+    // two cells across a face share it.
+    let mut quads: Vec<([u32; 4], u32)> = cells
+        .iter()
+        .flat_map(Cell::quads)
+        .enumerate()
+        .map(|(k, mut q)| {
+            q.sort_unstable();
+            (q, k as u32)
+        })
+        .collect();
+    quads.sort_unstable();
+    let faces = quads.chunk_by(|a, b| a.0 == b.0).count();
+    let middles = cells.iter().filter(|c| c.has_centre()).count();
+    if points.len() + faces + middles >= NONE as usize {
+        return Err(MeshError::TooLarge);
+    }
+    points.reserve(faces + middles);
+    index.reserve(faces + middles);
+    let mut centres = Centres {
+        start: Vec::with_capacity(faces + middles + 1),
+        corners: Vec::with_capacity(4 * faces + 8 * middles),
+    };
+    centres.start.push(0);
+    let mut quad_centre = alloc::vec![0u32; quads.len()];
+    for group in quads.chunk_by(|a, b| a.0 == b.0) {
+        let id = add_centre(points, index, &mut centres, &group[0].0);
+        for &(_, k) in group {
+            quad_centre[k as usize] = id;
+        }
+    }
     let mut tets = Vec::with_capacity(total);
     let mut cell_of = Vec::with_capacity(total);
+    let mut first_quad = 0;
     for (c, cell) in cells.iter().enumerate() {
-        let ids = cell.points();
-        if let Some(&index) = ids.iter().find(|&&i| i as usize >= points.len()) {
-            return Err(MeshError::IndexOutOfRange { cell: c, index });
-        }
-        if ids.iter().enumerate().any(|(k, i)| ids[..k].contains(i)) {
-            return Err(MeshError::RepeatedPoint { cell: c });
-        }
+        let centre = if cell.has_centre() {
+            let mut ids = [0u32; 8];
+            let ids = &mut ids[..cell.points().len()];
+            ids.copy_from_slice(cell.points());
+            ids.sort_unstable();
+            add_centre(points, index, &mut centres, ids)
+        } else {
+            NONE
+        };
+        let quads = &quad_centre[first_quad..];
+        first_quad += cell.quads().count();
         let start = tets.len();
         let mut sign = 0.0f64;
         let mut bad = None;
-        cell.split(|t| {
-            let p = t.map(|i| points[i as usize]);
-            let v = volume6(p);
-            let edge = longest_edge(p);
-            if v.abs() <= FLAT * edge * edge * edge || v.is_nan() {
-                bad.get_or_insert(MeshError::Degenerate { cell: c });
-            } else if sign * v < 0.0 {
-                bad.get_or_insert(MeshError::Inverted { cell: c });
-            }
-            sign = v;
-            tets.push(if v < 0.0 { [t[0], t[1], t[3], t[2]] } else { t });
-        });
+        cell.split(
+            centre,
+            |k| quads[k],
+            |t| {
+                let p = t.map(|i| points[i as usize]);
+                let v = volume6(p);
+                let edge = longest_edge(p);
+                if v.abs() <= FLAT * edge * edge * edge || v.is_nan() {
+                    bad.get_or_insert(MeshError::Degenerate { cell: c });
+                } else if sign * v < 0.0 {
+                    bad.get_or_insert(MeshError::Inverted { cell: c });
+                }
+                sign = v;
+                tets.push(if v < 0.0 { [t[0], t[1], t[3], t[2]] } else { t });
+            },
+        );
         if let Some(e) = bad {
             return Err(e);
         }
         cell_of.resize(tets.len(), c as u32);
         debug_assert_eq!(tets.len() - start, cell.tet_count());
     }
-    Ok((tets, cell_of))
+    if let Some((_, e)) = bad_index {
+        return Err(e);
+    }
+    Ok((tets, cell_of, centres))
+}
+
+/// Appends the mean of the points `ids` (sorted: the sums do not depend
+/// on the order a cell lists them in) and of their values; its index.
+/// Each term is divided before it is added, so finite points and values
+/// have a finite mean however large.
+fn add_centre(
+    points: &mut Vec<DVec3>,
+    index: &mut Vec<f64>,
+    centres: &mut Centres,
+    ids: &[u32],
+) -> u32 {
+    let count = ids.len() as f64;
+    let (mut p, mut n) = (DVec3::ZERO, 0.0);
+    for &i in ids {
+        p += points[i as usize] / count;
+        n += index[i as usize] / count;
+    }
+    points.push(p);
+    index.push(n);
+    centres.corners.extend_from_slice(ids);
+    centres.start.push(centres.corners.len() as u32);
+    (points.len() - 1) as u32
 }
 
 fn longest_edge(p: [DVec3; 4]) -> f64 {

@@ -15,6 +15,14 @@
 //! exactly the gradient of the interpolated `n`; the two differ at second
 //! order, which the invariant drift `| |T| − n |` reports.) Points are
 //! located through a uniform grid of buckets over the mesh.
+//!
+//! Both live on the mesh's split into tetrahedra (see [`super::Cell`]),
+//! which has no preferred direction, and the gradients are fitted at the
+//! input points only, through the input points sharing a cell with each
+//! (a structured mesh's 3 × 3 × 3 block): a centre point the split adds
+//! takes the mean of its corners' gradients, as its value is the mean of
+//! theirs (its value is no sample, so fitting through it would spoil the
+//! fits' second order).
 
 use alloc::vec::Vec;
 
@@ -51,13 +59,15 @@ impl SmoothField {
         &self.mesh
     }
 
-    /// The recovered `∇n` at each point.
+    /// The recovered `∇n` at each point (of [`UnstructuredField::points`]:
+    /// the input's).
     #[must_use]
     pub fn gradients(&self) -> &[DVec3] {
-        &self.gradients
+        &self.gradients[..self.mesh.inputs]
     }
 
-    /// Classic RK4 with steps of half the median edge length: second order
+    /// Classic RK4 with steps of half the median edge length of the input
+    /// cells (a structured mesh's spacing): second order
     /// in the cell size overall (the field's derivatives jump at faces,
     /// which caps RK4's order there), like the recovered gradients.
     #[must_use]
@@ -270,28 +280,49 @@ impl Locator {
     }
 }
 
-/// The median edge length (the first edge of each tetrahedron).
+/// The median edge length of the input cells: per tetrahedron, its first
+/// edge between two input points (every tetrahedron of the split has one:
+/// of a hexahedron or wedge, the cell's edge it is built on).
 fn median_edge(mesh: &UnstructuredField) -> f64 {
+    let inputs = mesh.inputs as u32;
     let mut e: Vec<f64> = mesh
         .tets
         .iter()
-        .map(|t| (mesh.points[t[1] as usize] - mesh.points[t[0] as usize]).length())
+        .filter_map(|t| {
+            let mut own = t.iter().filter(|&&p| p < inputs);
+            let (a, b) = (*own.next()?, *own.next()?);
+            Some((mesh.points[a as usize] - mesh.points[b as usize]).length())
+        })
         .collect();
+    if e.is_empty() {
+        return 0.0;
+    }
     let mid = e.len() / 2;
     e.select_nth_unstable_by(mid, f64::total_cmp);
     e[mid]
 }
 
-/// Each point's neighbours: the points sharing a tetrahedron with it
-/// (sorted, without itself).
+/// Each input point's neighbours: the input points sharing a cell with it
+/// (sorted, without itself). A cell's tetrahedra are consecutive, and
+/// together hold all its points.
 fn neighbours(mesh: &UnstructuredField) -> (Vec<u32>, Vec<u32>) {
-    let n = mesh.points.len();
+    let n = mesh.inputs;
     let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(12 * mesh.tets.len());
-    for t in &mesh.tets {
-        for a in 0..4 {
-            for b in 0..4 {
+    let mut corners: Vec<u32> = Vec::with_capacity(32);
+    let mut t = 0;
+    while t < mesh.tets.len() {
+        let cell = mesh.cell_of[t];
+        corners.clear();
+        while t < mesh.tets.len() && mesh.cell_of[t] == cell {
+            corners.extend(mesh.tets[t].iter().filter(|&&p| (p as usize) < n));
+            t += 1;
+        }
+        corners.sort_unstable();
+        corners.dedup();
+        for &a in &corners {
+            for &b in &corners {
                 if a != b {
-                    pairs.push((t[a], t[b]));
+                    pairs.push((a, b));
                 }
             }
         }
@@ -308,22 +339,22 @@ fn neighbours(mesh: &UnstructuredField) -> (Vec<u32>, Vec<u32>) {
     (start, pairs.into_iter().map(|(_, b)| b).collect())
 }
 
-/// Gradients at the points: a least-squares quadratic through the 1-ring
-/// (2-ring where the 1-ring is too small or flat), its gradient at the
-/// point; a linear fit, then the mean of the cells' gradients, where even
-/// that is singular.
+/// Gradients at the input points: a least-squares quadratic through the
+/// 1-ring (2-ring where the 1-ring is too small or flat), its gradient at
+/// the point; a linear fit, then the mean of the cells' gradients, where
+/// even that is singular. Then the added points': their corners' mean.
 fn recover(mesh: &UnstructuredField) -> Vec<DVec3> {
     let (start, adj) = neighbours(mesh);
     let ring = |p: usize| &adj[start[p] as usize..start[p + 1] as usize];
-    let mut cell_mean = alloc::vec![(DVec3::ZERO, 0u32); mesh.points.len()];
+    let mut cell_mean = alloc::vec![(DVec3::ZERO, 0u32); mesh.inputs];
     for (t, tet) in mesh.tets.iter().enumerate() {
-        for &p in tet {
+        for &p in tet.iter().filter(|&&p| (p as usize) < mesh.inputs) {
             cell_mean[p as usize].0 += mesh.gradients[t];
             cell_mean[p as usize].1 += 1;
         }
     }
     let mut two = Vec::new();
-    (0..mesh.points.len())
+    let mut gradients: Vec<DVec3> = (0..mesh.inputs)
         .map(|p| {
             let one = ring(p);
             if let Some(g) = fit(mesh, p, one, true) {
@@ -341,7 +372,14 @@ fn recover(mesh: &UnstructuredField) -> Vec<DVec3> {
                 if c > 0 { s / f64::from(c) } else { DVec3::ZERO }
             })
         })
-        .collect()
+        .collect();
+    gradients.reserve(mesh.points.len() - mesh.inputs);
+    for i in 0..mesh.points.len() - mesh.inputs {
+        let corners = mesh.centres.of(i);
+        let sum = corners.iter().map(|&p| gradients[p as usize]).sum::<DVec3>();
+        gradients.push(sum / corners.len() as f64);
+    }
+    gradients
 }
 
 /// The gradient at point `p` of a least-squares fit through `others`:

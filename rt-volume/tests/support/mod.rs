@@ -41,9 +41,9 @@ pub(crate) enum Kind {
     Pyramid,
     /// Six tetrahedra per grid cell around its main diagonal (Kuhn).
     Tet,
-    /// Hexahedra and pyramids, chosen per cell (both cut a grid face along
-    /// the diagonal through its lowest point, so they fit together; wedges
-    /// and Kuhn tetrahedra cut them along fixed diagonals).
+    /// Hexahedra and pyramids, chosen per cell (both cut a grid face about
+    /// its centre, so they fit together; wedges and Kuhn tetrahedra cut
+    /// them along diagonals).
     Mixed,
 }
 
@@ -152,9 +152,17 @@ pub(crate) fn box_mesh(
     (points, cells)
 }
 
-/// Boundary triangles of a box mesh of `dims` grid cells: two per grid face
-/// on the box's surface.
-pub(crate) fn box_boundary_triangles(dims: [usize; 3]) -> usize {
+/// Boundary triangles of a box mesh of `dims` grid cells of `kind`: four
+/// per grid face on the box's surface where the cells have a
+/// quadrilateral there (cut about its centre), two where they have two
+/// triangles (Kuhn tetrahedra everywhere, wedges across z).
+#[cfg(feature = "mesh")]
+pub(crate) fn box_boundary_triangles(dims: [usize; 3], kind: Kind) -> usize {
     let [x, y, z] = dims;
-    4 * (x * y + y * z + z * x)
+    let (across_z, sides) = (2 * x * y, 2 * (y * z + z * x));
+    match kind {
+        Kind::Tet => 2 * (across_z + sides),
+        Kind::Wedge => 2 * across_z + 4 * sides,
+        Kind::Hex | Kind::Pyramid | Kind::Mixed => 4 * (across_z + sides),
+    }
 }

@@ -128,7 +128,7 @@ stalled: + mean over the rays, the largest error of 8x8-ray pixel means
 and the rays that did not leave the far side) and
 unstructured_throughput.csv (method,case,cells,build_seconds,rays,threads,
 seconds,photons_per_s,cells_crossed,cells_per_s: a 256x256 beam through
-the N = 64 mesh, 1.57M tetrahedra, one thread and all cores;
+the N = 64 mesh, 6.29M tetrahedra, one thread and all cores;
 cells_crossed = sum of TraceStats::steps, the tetrahedra crossed).
 
 distributed writes distributed.csv (kind,ranks,seconds,items_sent,
