@@ -519,7 +519,11 @@ mod tests {
         let g = ColorMap::grayscale().with_range(10.0, 20.0).unwrap();
         assert_eq!(g.map(10.0), [0.0, 0.0, 0.0, 1.0]);
         assert_eq!(g.map(20.0), [1.0, 1.0, 1.0, 1.0]);
-        assert_eq!(g.map(15.0), [0.5, 0.5, 0.5, 1.0]);
+        // Halfway is mid grey on the sRGB curve, 0.214 in linear light.
+        assert_eq!(g.map_srgb(15.0), [0.5, 0.5, 0.5, 1.0]);
+        let half = srgb_to_linear(0.5);
+        assert_eq!(g.map(15.0), [half, half, half, 1.0]);
+        assert!((half - 0.214).abs() < 1e-3);
         assert_eq!(g.map(-1e30), [0.0, 0.0, 0.0, 1.0]);
         assert_eq!(g.map(f32::INFINITY), [1.0, 1.0, 1.0, 1.0]);
         assert_eq!(g.map(f32::NAN), g.nan_color);
@@ -531,9 +535,9 @@ mod tests {
         assert_eq!(v.map_srgb(0.0)[..3], [0.267004, 0.004874, 0.329415]);
         assert_eq!(v.map_srgb(1.0)[..3], [0.993248, 0.906157, 0.143936]);
         // Shading gets the table decoded once (0.267 on the sRGB curve is
-        // 0.058 linear), never the encoded value taken as linear.
+        // 0.0580 linear), never the encoded value taken as linear.
         assert!((v.map(0.0)[0] - srgb_to_linear(0.267004)).abs() < 1e-7);
-        assert!((v.map(0.0)[0] - 0.05824).abs() < 1e-4);
+        assert!((v.map(0.0)[0] - 0.05797).abs() < 1e-4);
         let c = ColorMap::cool_to_warm();
         let mid = c.map_srgb(0.5);
         assert!((mid[0] - 221.0 / 255.0).abs() < 1e-6 && mid[0] == mid[1] && mid[1] == mid[2]);
