@@ -787,3 +787,95 @@ fn focusing_writes_an_image_that_focuses() {
     assert!(help.status.success() && stdout(&help).contains("--source-distance"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// matplotlib's 256 viridis entries (sRGB), the data file rt-core's
+/// table test reads.
+fn published_viridis() -> Vec<[f64; 3]> {
+    include_str!("../../rt-core/tests/data/viridis.csv")
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with('r'))
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.trim().parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
+}
+
+/// The figure's colour bar against the published table: `rt view
+/// --figure` of a ramp through viridis over a given range; the bar's
+/// pixel rows run from the range's top to its bottom, each the published
+/// colour at its value within one 8-bit step (a map encoded twice showed
+/// the middle as (100, 198, 196), published (33, 145, 140)).
+#[test]
+fn the_figure_colour_bar_is_the_published_viridis() {
+    let dir = scratch("colour-bar");
+    let ply = dir.join("ramp.ply");
+    std::fs::write(
+        &ply,
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+         property float z\nproperty float s\nelement face 2\n\
+         property list uchar int vertex_indices\nend_header\n\
+         0 0 0 0\n1 0 0 1\n1 1 0 1\n0 1 0 0\n3 0 1 2\n3 0 2 3\n",
+    )
+    .unwrap();
+    let out = dir.join("ramp.png");
+    let o = rt(&[
+        "view",
+        ply.to_str().unwrap(),
+        "--scalar",
+        "s",
+        "--colormap",
+        "viridis",
+        "--range",
+        "0,1",
+        "--size",
+        "64x48",
+        "--figure",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (info, px) = decode(&dir.join("ramp-figure.png"));
+    let (w, h) = (info.width as usize, info.height as usize);
+    let at = |x: usize, y: usize| {
+        let p = 3 * (y * w + x);
+        [px[p], px[p + 1], px[p + 2]].map(i32::from)
+    };
+    let near = |c: [i32; 3], want: [i32; 3]| (0..3).all(|k| (c[k] - want[k]).abs() <= 2);
+    // The bar: in the legend (the right part), the column with the longest
+    // run of rows starting at viridis' top colour.
+    let (top, bottom) = ([253, 231, 37], [68, 1, 84]);
+    let mut best = (0, 0, 0);
+    for x in w / 2..w {
+        for y0 in 0..h {
+            if !near(at(x, y0), top) || (y0 > 0 && near(at(x, y0 - 1), top)) {
+                continue;
+            }
+            let mut y1 = y0;
+            while y1 + 1 < h && !near(at(x, y1 + 1), [255, 255, 255]) && at(x, y1 + 1) != [90; 3] {
+                y1 += 1;
+            }
+            if near(at(x, y1), bottom) && y1 - y0 > best.2 - best.1 {
+                best = (x, y0, y1);
+            }
+        }
+    }
+    let (x, y0, y1) = best;
+    assert!(y1 - y0 > 100, "no colour bar found ({best:?})");
+    let table = published_viridis();
+    // The bar's frame covers one row above and below the colours found.
+    let (first, rows) = (y0 - 1, (y1 - y0 + 3) as f64);
+    let mut worst = 0;
+    for y in y0..=y1 {
+        // Row y shows the value at its centre, 1 at the top, 0 at the bottom.
+        let s = 1.0 - ((y - first) as f64 + 0.5) / rows;
+        let f = s * 255.0;
+        let (i, t) = ((f.floor() as usize).min(254), f - f.floor().min(254.0));
+        let want = [0, 1, 2]
+            .map(|k| ((table[i][k] + t * (table[i + 1][k] - table[i][k])) * 255.0).round() as i32);
+        let got = at(x, y);
+        worst = worst.max((0..3).map(|k| (got[k] - want[k]).abs()).max().unwrap());
+    }
+    assert!(worst <= 1, "colour bar off the published table by {worst}/255");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
