@@ -4,11 +4,13 @@
 //! preferred direction (issue 43).
 #![cfg(feature = "mesh")]
 
+mod support;
+
 use rt_photo::glam::DVec3;
 use rt_photo::rt_volume::{Grid, GridField, Interp};
 use rt_photo::{
     Bench, Cell, Cutoff, Film, Filter, Mode, Reconstruction, SmoothField, TraceParams,
-    UnstructuredField, Weighting,
+    UnstructuredField,
 };
 
 /// Points a side of the lattice over `[-3, 3]³` (16 cells of 0.375).
@@ -104,20 +106,8 @@ fn grid() -> GridField {
 /// as `rt schlieren` sets it up (sheet reconstruction, 2 × 2 photons a
 /// pixel per pass).
 fn bench(angle: f64, params: TraceParams) -> Bench {
-    Bench {
-        center: DVec3::new(0.0, 0.0, -6.0),
-        direction: DVec3::Z,
-        u: DVec3::X,
-        width: 6.0,
-        height: 6.0,
-        image_plane: 6.0,
-        film_distance: 0.0,
-        mode: Mode::Schlieren(Cutoff::KnifeEdge { angle, offset: 0.0, f: 1.0, h: 1e-3 }),
-        weighting: Weighting::Weight,
-        reconstruction: Reconstruction::Sheet,
-        strata: 2,
-        params,
-    }
+    let knife = Mode::Schlieren(Cutoff::KnifeEdge { angle, offset: 0.0, f: 1.0, h: 1e-3 });
+    Bench { reconstruction: Reconstruction::Sheet, params, ..support::bench(knife, 2) }
 }
 
 /// Four passes of `render` onto a fresh film: the image, row by row
