@@ -660,7 +660,7 @@ mod tests {
     /// A weak flow (a Gaussian density bump, peak deflection 1e-4 rad,
     /// below the skipping tolerance of a bench without cutoff) is
     /// measured, not skipped: the survey's largest deflection is the
-    /// analytic `K·A·√(2π)·e^(−1/2)` of the bump (ORACLES §5) within the
+    /// analytic `K·A·√(2π)·e^(−1/2)` of the bump (docs/oracles.md §5) within the
     /// coarse survey's sampling. Before, it read 0, so the automatic
     /// exposure saturated knife-edge images and put the shadowgraph film
     /// at 0 m.
