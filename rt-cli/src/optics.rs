@@ -142,7 +142,7 @@ impl Volume {
 
     /// The trace settings for a grid: leapfrog with steps of two cells,
     /// the report's `rt-2voxel` setting, which reaches the same image error
-    /// as one-cell steps 1.3× faster (`rt-report schlieren`).
+    /// as one-cell steps in less time (`rt-report schlieren`).
     fn grid_params(&self) -> TraceParams {
         let base = TraceParams::for_grid(&self.field);
         TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base }
