@@ -1,4 +1,4 @@
-//! Criterion: what each skip of DESIGN §5 saves, one thread. Each group
+//! Criterion: what each skip of docs/physics.md §5 saves, one thread. Each group
 //! times the same frame or trace with the work present and skipped:
 //! - `shadows`, `ao`, `reflection`: a 128² frame of a 32k-triangle terrain
 //!   with mirroring glyphs, with and without shadow rays, AO rays (4) and

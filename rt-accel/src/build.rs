@@ -100,11 +100,9 @@ pub struct BuildParams {
     pub quality: BuildQuality,
     /// Most primitives per leaf, `1..=16` (clamped). Triangles are tested
     /// four at a time; leaves of several packets make the tree shallower,
-    /// which pays for incoherent rays (`rt-report traversal`: leaf 4 → 8
-    /// took incoherent rays from 0.92–0.95× to 1.0–1.05× of obvhs's
-    /// CWBVH, primary rays unchanged). [`BuildParams::medium`] allows 12
-    /// (three packets), which its node weight needs (`TRI_NODE_COST` in
-    /// `build.rs`); 16 measured the same.
+    /// which pays for incoherent rays at no cost to primary ones.
+    /// [`BuildParams::medium`] allows 12 (three packets), which its node
+    /// weight needs (`TRI_NODE_COST` in `build.rs`); 16 gains nothing more.
     pub max_leaf_size: u32,
 }
 
@@ -123,7 +121,7 @@ impl BuildParams {
     }
 
     /// obvhs's slow preset (more reinsertion, spatial pre-splits): a
-    /// slower build whose trees traced 0–25 % slower than
+    /// slower build whose trees traced slower than
     /// [`BuildParams::medium`]'s on the report's scenes; there for
     /// comparison, and for meshes of long thin triangles, where pre-splits
     /// can pay.
@@ -292,8 +290,8 @@ fn build_items<P: Primitive>(prims: Vec<P>, params: &BuildParams) -> Result<Bvh<
 
 /// The binned SAH builder's leaf size: four primitives (one triangle
 /// packet) or `max_leaf` if smaller. The collapse merges leaves up to
-/// `max_leaf`; binary leaves of eight left it nothing to choose (trees
-/// 10 % costlier on the report's scenes).
+/// `max_leaf`; binary leaves of eight left it nothing to choose (costlier
+/// trees).
 fn sah_leaf(max_leaf: u32) -> usize {
     max_leaf.min(4) as usize
 }
@@ -319,15 +317,9 @@ const ITEM_COST: f64 = 1.0;
 /// node costs more than a leaf of up to three packets over the same box,
 /// so a subtree of at most `max_leaf_size` triangles becomes a leaf (or
 /// is spread over its parent's free slots), never a small node of its
-/// own. Against a weight of 1 (with leaves of up to 8 triangles, not 12)
-/// the trees have 40–42 % fewer nodes (terrain 50 175 → 28 903,
-/// icosphere 60 509 → 36 598) and the single-ray rows of `rt-report
-/// traversal` against Embree 3 in the same process went (Zen 4, 12
-/// interleaved rounds each, medians; primary, shadow, AO, incoherent):
-/// terrain 1.05, 1.03, 1.02, 0.97 → 1.05, 1.09, 1.09, 1.13×; icosphere
-/// 0.99, 0.99, 1.05, 0.99 → 1.00, 1.06, 1.10, 1.06×.
-/// Weights of 4–8 took icosphere primary rays below 1.0×; 2 and 2.5
-/// gained less on the other rows.
+/// own: far fewer nodes than at a weight of 1, so a shorter chain of
+/// fetches for every ray. Heavier weights (4–8) slowed coherent rays on
+/// the icosphere, lighter ones (2, 2.5) gained less elsewhere.
 const TRI_NODE_COST: f64 = 3.0;
 /// The cost of one wide node's test above spheres and capsules (items of
 /// one primitive each): the weight triangles had before, not measured

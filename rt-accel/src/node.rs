@@ -11,14 +11,12 @@
 //! Why byte offsets: a traversal step loads a child reference, finds the
 //! node's address and loads its boxes, one after the other. From an index
 //! the address takes a multiply by 224 (3 cycles on the chain); from an
-//! offset, an addition the load's addressing does (every single-ray row
-//! of `rt-report traversal` +0.5–7.5 %). It caps a tree at [`MAX_NODES`]
-//! nodes, about 190 M triangles.
+//! offset, an addition the load's addressing does. It caps a tree at
+//! [`MAX_NODES`] nodes, about 190 M triangles.
 //!
 //! Why eight: incoherent rays on million-triangle scenes are bound by the
-//! chain of dependent node fetches from root to leaf; halving the depth of
-//! a 4-wide tree took them from 0.92–1.05× to 1.08–1.16× of obvhs's CWBVH
-//! (`rt-report traversal`), with primary rays unchanged.
+//! chain of dependent node fetches from root to leaf, which halving the
+//! depth of a 4-wide tree shortens, at no cost to primary rays.
 
 use glam::Vec3;
 use rt_core::Aabb;

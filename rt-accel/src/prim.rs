@@ -88,11 +88,10 @@ pub(crate) fn closest_leaf<P: Primitive, const AVX: bool>(
 /// Whether `ctx`'s ray hits any of a leaf's `items` before `t_max`. A
 /// plain loop, always inlined, so the leaf tests compile with the calling
 /// kernel's instruction set: `items.iter().any(…)` was left out of line,
-/// a generic function built for the baseline target (a fifth of an AO
-/// stream's time, on SSE2 code). `AVX` (only inside the kernels compiled
-/// with AVX, as `traverse::box_test`): triangle packets are tested two at
-/// a time, in eight lanes, with the same answer (shadow and AO rays
-/// +2.5–4 %).
+/// a generic function built for the baseline target (SSE2 code called
+/// from the AVX kernels). `AVX` (only inside the kernels compiled with
+/// AVX, as `traverse::box_test`): triangle packets are tested two at a
+/// time, in eight lanes, with the same answer.
 #[inline(always)]
 pub(crate) fn any_leaf<P: Primitive, const AVX: bool>(
     items: &[P],

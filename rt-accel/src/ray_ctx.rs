@@ -98,8 +98,8 @@ pub struct RayCtx {
 /// cancels to a subnormal only where `fl(p + 8u·|p|)` or `fl(8u·|q| − q)`
 /// lies within `2⁻¹²⁶` of `∓2⁻¹¹⁹`, an origin coordinate of about `2⁻¹¹⁹`
 /// ray lengths): a subnormal operand costs an Intel core's multiply-add a
-/// microcode assist (primary rays from an eye at `x = 0` ran 2.6× slower
-/// without floors). One addition each, where replacing the small offsets
+/// microcode assist (every primary ray from an eye at `x = 0` would pay
+/// it without floors). One addition each, where replacing the small offsets
 /// by the floor took a compare and a select.
 ///
 /// The bounds need every value above to be finite and the reciprocals
@@ -212,8 +212,8 @@ impl RayCtx {
     /// them (the single-ray AVX ones) build them with
     /// [`RayCtx::new_fused_avx`]; this portable form is what the tests
     /// check that one and the fused test against. Kept beside the
-    /// context, not in it: packets and streams, which store a context per
-    /// ray, ran 2–11 % slower with the larger one.
+    /// context, not in it: packets and streams store a context per ray,
+    /// and a larger one slowed them.
     #[cfg(test)]
     #[must_use]
     pub(crate) fn new_fused(ray: &Ray, tree_in_range: bool) -> Option<(Self, Fused)> {
@@ -334,8 +334,8 @@ impl RayCtx {
         let [kx, ky, kz] = wt.axes;
         let inv = glam::Vec3A::from(d).recip();
         // Indexed as an array: `Vec3`'s own indexing is a match, which
-        // compiled to branches on the axes (missed random rays 35 %
-        // slower).
+        // compiled to branches on the axes, mispredicted for rays of
+        // random direction.
         let wt_org = {
             let o = o.to_array();
             glam::Vec3::new(o[kx], o[ky], o[kz])

@@ -415,8 +415,7 @@ fn leaf_group<P: Primitive, const AVX: bool>(items: &[P], ctxs: &[RayCtx], activ
 /// fused one where it covers every ray (`FUSED`), with the plane rows
 /// loaded once for the group where all rays have the same octant
 /// (`SHARED`, see `group_box_avx`), else the robust one, short where every
-/// ray has `t_min ≥ 0` (`NONNEG`, see `box_test`: shadow and AO streams
-/// +2–5 %).
+/// ray has `t_min ≥ 0` (`NONNEG`, see `box_test`).
 /// The AVX kernels gather the rays' bits with two vector operations per
 /// ray; the 4-wide one bit by bit. Branch-free: which children a ray
 /// enters is unpredictable.

@@ -227,7 +227,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
         let root = ChildRef::inner(0);
         // Two instantiations per kernel: rays the fused test does not
         // cover take the general test on the AVX kernels (a third, the
-        // robust short test, made the kernels 4–7 % slower).
+        // robust short test, made the kernels slower).
         if AVX && fz.on {
             self.occluded_from::<AVX, true, true>(ctx, fz, root, stack)
         } else if !AVX && ctx.ray.t_min >= 0.0 {
@@ -340,11 +340,8 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     /// farthest first): the one visited after the nearest, to overlap its
     /// memory latency, and of the others only the leaves.
     /// Prefetching every stacked child (four lines per node) cost more
-    /// than it saved (icosphere primary rays 3.48 -> 3.60 Mrays/s with
-    /// only the next one, incoherent unchanged); adding the other leaves,
-    /// whose triangles are a ray's largest misses, took incoherent rays
-    /// +2.5–7 % and primary rays −2.8 to +0.5 % (binned SAH trees, two
-    /// interleaved runs).
+    /// than it saved; the leaves are worth it, since their triangles are
+    /// a ray's largest misses.
     #[inline(always)]
     fn prefetch_stacked(&self, stacked: &[ChildRef]) {
         if let Some((&next, others)) = stacked.split_last() {
@@ -465,10 +462,8 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
             // The line of the child references, which the traversal reads
             // only once the boxes are tested, fetched beside the boxes (a
             // 224-byte node's last line may hold none of them, and would
-            // be missed only then). Closest-hit rays +1.6–3 %
-            // (primary), +4–10 % (incoherent) over two interleaved runs;
-            // the occlusion kernel, which loads the references with the
-            // boxes, gained nothing.
+            // be missed only then). The occlusion kernel loads the
+            // references with the boxes and needs no such prefetch.
             prefetch_line(&node.children);
             // A box entered at (rounded) distance just past the best hit
             // may still hold an exact tie; widen the bound as the far
@@ -488,9 +483,8 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                     // (likely why it helps: the next step branches on
                     // what the child is, which mispredicts for rays of
                     // random direction, and its loads would wait for the
-                    // recovery): incoherent rays +3.5–5 % (icosphere) and
-                    // +2.3 % (terrain) against Embree, primary rays
-                    // 0.5–1 % slower (Zen 4, 10–15 interleaved rounds).
+                    // recovery). It pays on incoherent rays and costs
+                    // coherent ones next to nothing.
                     self.prefetch(*cur);
                     return true;
                 }
@@ -507,11 +501,8 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                 }
                 // Three or more on the fused kernels: sorted without a
                 // branch (`push_sorted`). The insertion sort below
-                // mispredicts for rays of random direction; on incoherent
-                // rays this took the 1.3M-triangle icosphere +4.4 % and
-                // the terrain +1.4 % against Embree in the same process,
-                // coherent rows unchanged within noise (Zen 4, 15 and 10
-                // interleaved rounds).
+                // mispredicts for rays of random direction; a sorting
+                // network does not, and coherent rays lose nothing.
                 #[cfg(target_arch = "x86_64")]
                 if AVX && FUSED && *sp + WIDTH <= STACK_SIZE {
                     let k = mask.count_ones() as usize;
@@ -537,9 +528,8 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
                             k - 1,
                         )
                     };
-                    // The child visited next (as with one or two hit:
-                    // icosphere primary rays +1.1 %, other rows within
-                    // noise), then the stacked ones.
+                    // The child visited next (as with one or two hit),
+                    // then the stacked ones.
                     self.prefetch(near);
                     self.prefetch_stacked(pushed);
                     *sp += k - 1;
@@ -804,13 +794,13 @@ unsafe fn push_sorted(
 /// `NONNEG`: the caller knows the ray has `t_min ≥ 0` (the kernels pick
 /// it per ray), and the mask is one compare, `t0 ≤ min(t1x, t1y, t1z,
 /// t_max)`, instead of two multiplies, three compares and two logical
-/// operations (+2–5 % on every single-ray row).
+/// operations.
 ///
 /// `FUSED` (AVX kernels only; `fz.on` must hold): the fused test
 /// ([`box_lanes_fused`]), one multiply-add per plane, admitting every box
 /// the robust test admits (and a sliver more), so the hits are the same.
 /// The single-ray kernels pick it per ray, at entry: chosen per node
-/// instead, by a branch on `fz.on`, the kernels ran 3–6 % slower.
+/// instead, a branch on `fz.on` sits on every node step.
 #[inline(always)]
 pub(crate) fn box_test<const AVX: bool, const NONNEG: bool, const FUSED: bool>(
     node: &Node,
@@ -1069,8 +1059,7 @@ impl<P: Primitive> SceneQuery for BvhRef<'_, P> {
 
     /// On the AVX kernels ray by ray, where single rays take the fused
     /// node test and the packets do not: measured faster there (`rt-report
-    /// render`'s frames 1–6 % faster, the traversal report's `rt` row at
-    /// or above `rt-packet8` on both primary rows); through
+    /// render`'s frames and the traversal report's primary rows); through
     /// [`BvhRef::closest_t_packet`] on the 4-wide kernels. The same hits
     /// either way.
     fn closest_hit_packet(&self, rays: &[Ray; crate::PACKET]) -> [Option<Hit>; crate::PACKET] {

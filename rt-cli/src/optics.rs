@@ -142,7 +142,7 @@ impl Volume {
 
     /// The trace settings for a grid: leapfrog with steps of two cells,
     /// the report's `rt-2voxel` setting, which reaches the same image error
-    /// as one-cell steps 1.3× faster (`rt-report schlieren`).
+    /// as one-cell steps in less time (`rt-report schlieren`).
     fn grid_params(&self) -> TraceParams {
         let base = TraceParams::for_grid(&self.field);
         TraceParams { step: 2.0 * base.step, max_step: 2.0 * base.max_step, ..base }
@@ -660,7 +660,7 @@ mod tests {
     /// A weak flow (a Gaussian density bump, peak deflection 1e-4 rad,
     /// below the skipping tolerance of a bench without cutoff) is
     /// measured, not skipped: the survey's largest deflection is the
-    /// analytic `K·A·√(2π)·e^(−1/2)` of the bump (ORACLES §5) within the
+    /// analytic `K·A·√(2π)·e^(−1/2)` of the bump (docs/oracles.md §5) within the
     /// coarse survey's sampling. Before, it read 0, so the automatic
     /// exposure saturated knife-edge images and put the shadowgraph film
     /// at 0 m.

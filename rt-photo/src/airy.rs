@@ -1,5 +1,5 @@
 //! Diffraction blur: the Airy pattern of a lens's circular aperture, on
-//! the sensor's pixels (DESIGN §4 "Sensor").
+//! the sensor's pixels (docs/physics.md §11).
 //!
 //! At wavelength `λ` a lens whose light converges on the sensor at
 //! f-number `N` images a point as the Airy pattern

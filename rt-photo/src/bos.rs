@@ -1,7 +1,7 @@
 //! Background-oriented schlieren (BOS; Raffel, Exp. Fluids 56:60, 2015):
 //! a camera focused on a dotted background looks through the flow; the
 //! flow bends the rays, so the background's image moves by
-//! `Δ = M·Z_D·ε` (paraxially, ORACLES §7), `M = f/(Z_B − f)`, `Z_D` from
+//! `Δ = M·Z_D·ε` (paraxially, docs/oracles.md §7), `M = f/(Z_B − f)`, `Z_D` from
 //! the flow's mid-plane to the background.
 //!
 //! The camera is a thin lens ([`ThinLens`]): each pixel's rays are traced

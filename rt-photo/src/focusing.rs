@@ -32,7 +32,7 @@
 //! (across the bands) moves every `s₁` by `δ = ε·(Z_S − z)`, so
 //! `I/I₀ = 1 + δ/o`: the knife edge of a conventional schlieren system of
 //! focal length `Z_S − z` whose source image of height `2o` is half cut
-//! (`1 + 2 f ε / h`, ORACLES §5).
+//! (`1 + 2 f ε / h`, docs/oracles.md §5).
 //!
 //! The depth of sharp focus (geometric): the rays of a focus point fill a
 //! cone of the aperture's diameter `D` at the lens, so at a distance `Δz`

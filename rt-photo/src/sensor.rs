@@ -1,5 +1,5 @@
 //! A camera sensor: an image of relative intensity recorded as a camera
-//! would record it (DESIGN §4 "Sensor").
+//! would record it (docs/physics.md §11).
 //!
 //! A pixel of intensity `I` (1 = the background) collects `e = E·I`
 //! electrons on average, `E` the exposure; the recorded count is

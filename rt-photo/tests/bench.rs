@@ -1,4 +1,4 @@
-//! The optical bench against exact answers (ORACLES §5), conservation and
+//! The optical bench against exact answers (docs/oracles.md §5), conservation and
 //! determinism.
 
 mod support;
@@ -71,7 +71,7 @@ fn photon_weight_is_conserved() {
     }
 }
 
-/// ORACLES §5: knife-edge schlieren of a weak Gaussian bump against the
+/// docs/oracles.md §5: knife-edge schlieren of a weak Gaussian bump against the
 /// analytic intensity `clamp(0.5 + (f/h) ε_x)`, with 128²·64 ≈ 1M photons:
 /// RMSE ≤ 1 % of the (half-cut) background. (Photons land at their exit
 /// points, displaced inside the bump.)
@@ -235,7 +235,7 @@ fn bad_parameters_are_errors() {
 }
 
 /// Linearised shadowgraph of a weak bump at small `L`:
-/// `I/I₀ ≈ 1 + L·A·g(r)·(2 − r²/σ²)`, `A = √(2π)·δ/σ` (ORACLES §5); 1M
+/// `I/I₀ ≈ 1 + L·A·g(r)·(2 − r²/σ²)`, `A = √(2π)·δ/σ` (docs/oracles.md §5); 1M
 /// photons on 32² pixels keep the count noise below the 5 % signal.
 #[test]
 fn shadowgraph_matches_the_linearised_gaussian() {
@@ -269,7 +269,7 @@ fn shadowgraph_matches_the_linearised_gaussian() {
     assert!(f0 > 2.0 * e, "the 5 % signal must stand out: flat rmse {f0}");
 }
 
-/// ORACLES §6: as the bump weakens, the traced deflection converges to the
+/// docs/oracles.md §6: as the bump weakens, the traced deflection converges to the
 /// line-of-sight integral of the gradient along the unbent ray (for the
 /// Gaussian, `−√(2π)·δ·(x/σ)·g(r)`), the relative difference falling
 /// linearly with δ.
@@ -449,9 +449,9 @@ fn parallel_splat_equals_serial_splat() {
     }
 }
 
-/// ORACLES §5 at `σ = 1 cm` (a bump in metres, as in §7's BOS vector): the
+/// docs/oracles.md §5 at `σ = 1 cm` (a bump in metres, as in §7's BOS vector): the
 /// deflection is an angle, `ε = −√(2π)·δ·(r/σ)·g(r)`, whatever the bump's
-/// scale (the page's earlier form carried a spurious `1/σ`, 100× here),
+/// scale (an earlier statement of it carried a spurious `1/σ`, 100× here),
 /// the shadowgraph's contrast scales as `A = √(2π)·δ/σ` and the phase as
 /// `σ·δ`. Knife edge, shadowgraph and interferometry, with the sheet.
 #[test]

@@ -1,11 +1,11 @@
-//! Background-oriented schlieren against ORACLES §7 and the thin-lens
+//! Background-oriented schlieren against docs/oracles.md §7 and the thin-lens
 //! formulas.
 
 use glam::DVec3;
 use rt_photo::{Background, Bos, DotBackground, DotGrid, ImageBackground, ThinLens, TraceParams};
 use rt_volume::{Bounds, Constant, GaussianBump};
 
-/// ORACLES §7's camera: f = 0.1 m focused on the background at Z_B = 2.1 m
+/// docs/oracles.md §7's camera: f = 0.1 m focused on the background at Z_B = 2.1 m
 /// (M = 0.05), 5 µm pixels, looking along +z from the origin.
 fn camera(f_number: f64, width: usize, height: usize) -> ThinLens {
     ThinLens {

@@ -1,5 +1,5 @@
 //! Focusing schlieren: the conventional knife edge it reduces to
-//! (ORACLES §5), a brute-force forward simulation it must agree with, and
+//! (docs/oracles.md §5), a brute-force forward simulation it must agree with, and
 //! its depth of focus.
 
 use glam::DVec3;
@@ -36,7 +36,7 @@ fn set_up(cam: ThinLens, grid: SourceGrid, offset: f64, k: u32) -> FocusingSchli
     }
 }
 
-/// ORACLES §5: the deflection of a ray through a Gaussian bump at impact
+/// docs/oracles.md §5: the deflection of a ray through a Gaussian bump at impact
 /// parameter `x` (signed, along x), toward the centre.
 fn eps(delta: f64, sigma: f64, x: f64) -> f64 {
     -(core::f64::consts::TAU).sqrt()
@@ -113,7 +113,7 @@ fn thin_bump(
     }
 }
 
-/// The thin bump's deflection across x at `(x, y)`, ORACLES §5 for a
+/// The thin bump's deflection across x at `(x, y)`, docs/oracles.md §5 for a
 /// bump of thickness σ_z: `−√(2π)·δ·(σ_z/σ)·(x/σ)·exp(−ρ²/2σ²)`.
 fn thin_eps(delta: f64, sigma: f64, sigma_z: f64, x: f64, y: f64) -> f64 {
     -(core::f64::consts::TAU).sqrt() * delta * sigma_z / sigma

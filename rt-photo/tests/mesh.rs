@@ -53,7 +53,7 @@ fn max_diff(a: &[f32], b: &[f32]) -> f64 {
     a.iter().zip(b).map(|(x, y)| f64::from((x - y).abs())).fold(0.0, f64::max)
 }
 
-/// A Gaussian bump (ORACLES §5) sampled on grids of 7, 13 and 25 points a
+/// A Gaussian bump (docs/oracles.md §5) sampled on grids of 7, 13 and 25 points a
 /// side: the knife-edge images from the trilinear grid and from the mesh's
 /// tetrahedra differ by what the two interpolants do, at second order in
 /// the spacing while that difference is above the grid's `f32` samples'

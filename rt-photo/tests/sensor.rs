@@ -1,5 +1,5 @@
 //! The sensor model against its definition and the statistics of its
-//! noise (DESIGN §4 "Sensor").
+//! noise (docs/physics.md §11).
 
 use rt_photo::{Airy, Sensor, SensorError};
 

@@ -1,5 +1,5 @@
 //! The sheet estimator ([`Reconstruction::Sheet`]): exact background,
-//! conservation through folds, accuracy against ORACLES §5 with a fraction
+//! conservation through folds, accuracy against docs/oracles.md §5 with a fraction
 //! of the photons splatting needs, determinism.
 
 mod support;
@@ -91,7 +91,7 @@ fn light_is_conserved_through_folds() {
     assert!(peak > 3.0, "peak {peak}");
 }
 
-/// ORACLES §5, knife edge on a weak Gaussian bump, `clamp(0.5 + (f/h) ε_x)`:
+/// docs/oracles.md §5, knife edge on a weak Gaussian bump, `clamp(0.5 + (f/h) ε_x)`:
 /// with 16 photons per pixel the sheet is within 0.04 % of the background
 /// (measured 0.007 %); the same photons splatted with the tent filter err
 /// by 3.6 % (splatting needs 64 per pixel for 1 %).
@@ -118,7 +118,7 @@ fn knife_edge_matches_the_analytic_gaussian_with_few_photons() {
     assert!(es > 20.0 * e, "splatting {es} vs sheet {e}");
 }
 
-/// ORACLES §5, shadowgraph of the Gaussian bump at L = 100 against the
+/// docs/oracles.md §5, shadowgraph of the Gaussian bump at L = 100 against the
 /// linearised intensity `1 + L·∇²φ`: the sheet at 16 photons per pixel
 /// is within 1e-3 (measured 2.9e-4); splatting reaches 6e-3 with 1024.
 #[test]

@@ -1,4 +1,4 @@
-"""Shared by the tests: the Gaussian bump of ORACLES §5, pixel centres,
+"""Shared by the tests: the Gaussian bump of docs/oracles.md §5, pixel centres,
 and a reader for the 16-bit PNGs `rt schlieren --raw16` writes."""
 
 import math
@@ -36,7 +36,7 @@ def pixel_centres(vol, shape):
 
 
 def bump_deflection(X, Y, sigma, delta):
-    """ORACLES §5: `ε = −√(2π)·δ·(r/σ)·g(r)·r̂`, as (εx, εy)."""
+    """docs/oracles.md §5: `ε = −√(2π)·δ·(r/σ)·g(r)·r̂`, as (εx, εy)."""
     g = np.exp(-(X**2 + Y**2) / (2 * sigma**2))
     k = -math.sqrt(2 * math.pi) * delta / sigma * g
     return k * X, k * Y

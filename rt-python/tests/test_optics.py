@@ -1,4 +1,4 @@
-"""The optical bench from Python against ORACLES §5's Gaussian bump, and
+"""The optical bench from Python against docs/oracles.md §5's Gaussian bump, and
 against the `rt` command's own output for the same volume and seed."""
 
 import json

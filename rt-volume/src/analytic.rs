@@ -1,4 +1,4 @@
-//! Analytic index fields: the closed-form cases of `ORACLES.md` and any
+//! Analytic index fields: the closed-form cases of `docs/oracles.md` and any
 //! user closure pair.
 
 use glam::DVec3;
@@ -29,7 +29,7 @@ impl IndexField for Constant {
     }
 }
 
-/// Linear index `n = n₀ + g·x` (rays are catenaries, ORACLES §1).
+/// Linear index `n = n₀ + g·x` (rays are catenaries, docs/oracles.md §1).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LinearIndex {
     /// Index at the origin.
@@ -49,7 +49,7 @@ impl IndexField for LinearIndex {
     }
 }
 
-/// Linear `n² = n₀² + a·x` (rays are parabolas, ORACLES §2).
+/// Linear `n² = n₀² + a·x` (rays are parabolas, docs/oracles.md §2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LinearSquared {
     /// Index at the origin.
@@ -71,7 +71,7 @@ impl IndexField for LinearSquared {
 }
 
 /// Parabolic GRIN rod about the z axis: `n² = n₀²(1 − α² r²)`, `r² = x² + y²`
-/// (ORACLES §3).
+/// (docs/oracles.md §3).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GrinRod {
     /// Index on the axis.
@@ -96,7 +96,7 @@ impl IndexField for GrinRod {
 }
 
 /// Luneburg lens of radius `R` at `center`: `n = √(2 − r²/R²)` inside,
-/// `1` outside (ORACLES §4). Bounds: the cube around the sphere.
+/// `1` outside (docs/oracles.md §4). Bounds: the cube around the sphere.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Luneburg {
     /// Centre.
@@ -121,7 +121,7 @@ impl IndexField for Luneburg {
     }
 }
 
-/// Gaussian bump `n = n_a + δ·exp(−ρ²/(2σ²))`, `ρ = |x − c|` (ORACLES §5).
+/// Gaussian bump `n = n_a + δ·exp(−ρ²/(2σ²))`, `ρ = |x − c|` (docs/oracles.md §5).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GaussianBump {
     /// Centre.

@@ -666,7 +666,7 @@ fn fixed_step<F: IndexField>(
             // in the uniform region after it, `∫ n² dt` would drift from
             // `n × (distance moved)` in proportion to that distance (a
             // 2.5 % phase error through a Gaussian bump at two-cell
-            // steps, ORACLES §5); the chord never does.
+            // steps, docs/oracles.md §5); the chord never does.
             let (n_a, g_a) = ev.n(y.x)?;
             let t_half = y.t + 0.5 * h * n_a * g_a;
             let x = y.x + h * t_half;

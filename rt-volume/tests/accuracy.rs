@@ -9,7 +9,7 @@ use rt_volume::{
     TraceParams, TraceResult, build_octree, trace, trace_skipping,
 };
 
-/// ORACLES §1 in any orientation: in `n = n₀ + g·x` a ray lies in the
+/// docs/oracles.md §1 in any orientation: in `n = n₀ + g·x` a ray lies in the
 /// plane of its launch `T₀` and `g`. With `G = |g|`, `ĝ = g/G`, the
 /// launch index `ν₀ = n(x₀)`, `a = T₀·ĝ` and `P = T₀ − a ĝ` (constant,
 /// `|P|² = ν₀² − a²`), the index along the ray obeys `ν'' = G²ν` in `t`:
@@ -177,7 +177,7 @@ fn slanted_exit_keeps_every_schemes_order() {
     }
 }
 
-/// The adaptive preset on a weak and a strong Gaussian bump (ORACLES §5:
+/// The adaptive preset on a weak and a strong Gaussian bump (docs/oracles.md §5:
 /// δ = 1e-8 and 1e-3, at two scales σ): the deflection agrees with
 /// fixed-step RK4 at a fine step to 1e-6 relative in both. (With steps
 /// uncapped, δ = 1e-8 grew them to several σ, where the error estimate is

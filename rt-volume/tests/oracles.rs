@@ -1,4 +1,4 @@
-//! The closed-form oracles of `ORACLES.md` §1–§5, and the invariants.
+//! The closed-form oracles of `docs/oracles.md` §1–§5, and the invariants.
 
 use glam::DVec3;
 use rt_volume::{

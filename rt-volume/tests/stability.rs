@@ -138,7 +138,7 @@ fn bad_fields_rays_and_params_are_errors() {
     }
 }
 
-/// ORACLES §1 at every scale: the catenary in `n = 1 + (0.2/s)·y` over a
+/// docs/oracles.md §1 at every scale: the catenary in `n = 1 + (0.2/s)·y` over a
 /// box scaled by `s = 10^k`, k in -8..=8, launched along +x (direction
 /// also scaled, by 1/s), with the step and path limit scaled with the box.
 /// The path has the same shape at every scale, so the exit height over `s`

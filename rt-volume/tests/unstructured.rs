@@ -1,6 +1,6 @@
 //! Curved rays through unstructured meshes: exact for linear cells
-//! (ORACLES §1 on any tetrahedral mesh), second-order convergent for smooth
-//! data (ORACLES §5), watertight, and every bad mesh an `Err`.
+//! (docs/oracles.md §1 on any tetrahedral mesh), second-order convergent for smooth
+//! data (docs/oracles.md §5), watertight, and every bad mesh an `Err`.
 #![cfg(feature = "mesh")]
 
 mod support;
@@ -21,7 +21,7 @@ fn linear(points: &[DVec3], n0: f64, g: f64) -> Vec<f64> {
     points.iter().map(|p| n0 + g * p.y).collect()
 }
 
-/// ORACLES §1 on random meshes of the box `[0,2]×[−1,1]²`: exit position,
+/// docs/oracles.md §1 on random meshes of the box `[0,2]×[−1,1]²`: exit position,
 /// direction and optical path equal the catenary to 1e-10 relative, for
 /// every kind of cell, shuffled numbering, jittered points and cell sizes
 /// from 1/3 to 1/24 of the box.
@@ -74,7 +74,7 @@ fn linear_index_is_the_catenary_on_every_mesh() {
     assert!(worst > 0.0, "round-off is never exactly zero over 240 rays");
 }
 
-/// Deflection through the Gaussian bump of ORACLES §5 sampled at the points
+/// Deflection through the Gaussian bump of docs/oracles.md §5 sampled at the points
 /// of meshes refined ×2, ×4, ×8, traced exactly cell by cell: the only
 /// error left is the piecewise-linear interpolant's, whose gradient is
 /// first-order accurate, so a single ray's deflection error halves with the
@@ -357,7 +357,7 @@ fn rays_held_on_a_face_slide_along_it() {
             let r = field.trace(DVec3::new(x, y, -5.0), DVec3::Z).unwrap();
             assert_eq!(r.exit, Exit::Left, "({x}, {y}): {r:?}");
             assert!(r.stats.steps < 200, "({x}, {y}): {} steps", r.stats.steps);
-            // Bent toward the centre, within the plane, by ORACLES §5's
+            // Bent toward the centre, within the plane, by docs/oracles.md §5's
             // deflection as well as cells of one σ resolve it (the report's
             // bump-8 errors reach 0.8 of the peak).
             let eps = 2.506628 * 1e-4 * (2.0 * s * s).sqrt() * (-s * s).exp();

@@ -48,12 +48,11 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     // off a plane through 0 is a subnormal, which that product rounds to
     // −0 once `|w| > 1`, so the plane was hit at `t = −0`. At least
     // `4·MIN_POSITIVE·|w|` away, the product is a normal number.
-    // Both roundings are computed and one is selected, without branches
-    // (inlined, this took a renderer's AO frame from 8 % in this function
-    // to ~1 %). The step is at least `4·MIN_POSITIVE`, never subnormal:
-    // `4·MIN_POSITIVE·|w|` is subnormal for `|w| < 1/4`, and an Intel core
-    // takes a microcode assist (~100 cycles) for every subnormal result,
-    // which made this line 7 % of a renderer's AO frame.
+    // Both roundings are computed and one is selected, without branches,
+    // and inlined: this runs for every secondary ray. The step is at least
+    // `4·MIN_POSITIVE`, never subnormal: `4·MIN_POSITIVE·|w|` is subnormal
+    // for `|w| < 1/4`, and an Intel core takes a microcode assist (~100
+    // cycles) for every subnormal result, on every secondary ray.
     let axis = |po: f32, p: f32, side: f32, w: f32| {
         let step = (4.0 * f32::MIN_POSITIVE) * w.abs().max(1.0);
         let up = next_float_up(po).max(p + step);

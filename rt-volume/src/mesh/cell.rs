@@ -109,7 +109,7 @@ impl Cell {
     }
 
     /// How many tetrahedra the split gives: 1, 4, 14 and 24 (see the
-    /// [module](self)'s docs).
+    /// module docs of `mesh::cell`, or `docs/physics.md` §6).
     #[must_use]
     pub fn tet_count(&self) -> usize {
         match self {

@@ -15,7 +15,7 @@
 //! with `S = sinh(gt)/g`, `C = (cosh(gt) − 1)/g²`, `D = (sinh(gt) − gt)/g³`,
 //! `sinhc(u) = sinh(u)/u` and `sm(u) = (sinh(u) − u)/u³`, all evaluated from
 //! series near `u = 0` so that `g → 0` (a uniform cell: a straight line) is
-//! exact too. This is the catenary of ORACLES §1 in the plane of `T₀` and
+//! exact too. This is the catenary of docs/oracles.md §1 in the plane of `T₀` and
 //! `G`, with no step and no truncation error.
 //!
 //! **Leaving the cell.** A face plane's signed distance along the path,

@@ -1,9 +1,9 @@
 //! Background-oriented schlieren: the ground-truth displacement against
-//! the paraxial relation `Δ = M·Z_D·ε` (ORACLES §7) and against a
+//! the paraxial relation `Δ = M·Z_D·ε` (docs/oracles.md §7) and against a
 //! converged render, over aperture samples, integrators and octree
 //! skipping, with the run time of each.
 //!
-//! The flow is ORACLES §7's Gaussian bump (δ = 1e-4, σ = 1 cm at
+//! The flow is docs/oracles.md §7's Gaussian bump (δ = 1e-4, σ = 1 cm at
 //! Z_A = 1.1 m; the camera, f = 0.1 m, focused on the background at
 //! Z_B = 2.1 m, M = 0.05, 5 µm pixels), analytic or sampled on a 96³ grid
 //! of 1 mm (±4.75σ). Case `paraxial`: an f/400 camera (the rays of a pixel
@@ -66,7 +66,7 @@ fn gridded(interp: Interp) -> Result<GridField, String> {
     GridField::new(grid, interp, 1.0).map_err(|e| e.to_string())
 }
 
-/// ORACLES §7 at every pixel: the displacement (pixels, x right, y down)
+/// docs/oracles.md §7 at every pixel: the displacement (pixels, x right, y down)
 /// of the background seen through the chief ray's impact point.
 fn paraxial(cam: &ThinLens) -> Vec<[f64; 2]> {
     let m = cam.magnification();
@@ -204,7 +204,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     openpiv_closure(dir, &mut md, &mut verdicts);
     Ok(Section {
         title: format!(
-            "bos (ORACLES §7 bump, {side}² pixels, analytic or on a 96³ grid; paraxial: f/400 against Δ = M·Z_D·ε; f8: against the analytic field at 64 samples, adaptive 1e-10)"
+            "bos (docs/oracles.md §7 bump, {side}² pixels, analytic or on a 96³ grid; paraxial: f/400 against Δ = M·Z_D·ε; f8: against the analytic field at 64 samples, adaptive 1e-10)"
         ),
         body: md,
         verdicts,

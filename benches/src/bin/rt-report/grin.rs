@@ -1,7 +1,7 @@
 //! Curved-ray integrators: endpoint error against run time, per case and
 //! integrator, over a sweep of steps (fixed-step methods) or tolerances
 //! (adaptive). Error is measured against the closed-form oracles of
-//! `ORACLES.md` (`gaussian`, which has no closed form beyond first order:
+//! `docs/oracles.md` (`gaussian`, which has no closed form beyond first order:
 //! against RK4 at step 2e-4).
 
 use std::{fmt::Write as _, path::Path};

@@ -1,4 +1,4 @@
-//! Unstructured meshes against grids on the Gaussian bump of ORACLES §5
+//! Unstructured meshes against grids on the Gaussian bump of docs/oracles.md §5
 //! (`n = 1 + δ·exp(−|x|²/2σ²)`, δ = 1e-4, σ = 1, box `[−4σ, 4σ]³`).
 //!
 //! For N = 8, 16, 32, 64 cells per side the bump is sampled at the points
@@ -41,7 +41,7 @@ const DELTA: f64 = 1e-4;
 const SIGMA: f64 = 1.0;
 /// Half the box's side (4σ).
 const HALF: f64 = 4.0 * SIGMA;
-/// The bump's peak deflection (ORACLES §5): errors are relative to it.
+/// The bump's peak deflection (docs/oracles.md §5): errors are relative to it.
 const PEAK: f64 = 1.520347e-4;
 /// Where the rays start (in front of the box, along +z).
 const START_Z: f64 = -5.0;
