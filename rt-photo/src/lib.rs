@@ -84,29 +84,27 @@ extern crate alloc;
 #[cfg(feature = "std")]
 extern crate std;
 
-mod airy;
-mod background;
-mod bench;
 mod bos;
-mod cutoff;
-mod film;
+mod camera;
 mod focusing;
 mod math;
 #[cfg(feature = "mesh")]
 mod mesh;
-mod rig;
-mod sensor;
-mod sheet;
+mod rows;
+mod schlieren;
 
-pub use airy::{Airy, AiryKernel};
-pub use background::{Background, DotBackground, DotGrid, ImageBackground};
-pub use bench::{Bench, BenchError, Mode, Reconstruction, Weighting};
-pub use bos::{Bos, BosError, BosImages, ThinLens};
-pub use cutoff::{Cutoff, CutoffError, CutoffParam, FilterImage};
-pub use film::{Film, FilmError, Filter, Photon};
-pub use focusing::{FocusingError, FocusingImages, FocusingSchlieren, SourceGrid};
-pub use rig::{BosRig, BosRigOptions, FocusingRig, FocusingRigOptions};
-pub use sensor::{Sensor, SensorError};
+pub use bos::{
+    Background, Bos, BosError, BosImages, BosRig, BosRigOptions, DotBackground, DotGrid,
+    ImageBackground,
+};
+pub use camera::{Airy, AiryKernel, CameraError, Sensor, SensorError, ThinLens};
+pub use focusing::{
+    FocusingError, FocusingImages, FocusingRig, FocusingRigOptions, FocusingSchlieren, SourceGrid,
+};
+pub use schlieren::{
+    Bench, BenchError, Cutoff, CutoffError, CutoffParam, Film, FilmError, Filter, FilterImage,
+    Mode, Photon, Reconstruction, Weighting,
+};
 // The types in this crate's signatures, from the crates below it (and
 // `build_octree`, the only way to the `Octree` that `render_grid` takes).
 pub use rt_core::ColorMap;

@@ -45,7 +45,9 @@ impl Bench {
         seed: u64,
     ) -> Result<(), BenchError> {
         let tracer = |o: DVec3, d: DVec3| {
-            crate::bench::mean_colour(scalar, map, |visit| field.trace_visiting(o, d, visit))
+            crate::schlieren::bench::mean_colour(scalar, map, |visit| {
+                field.trace_visiting(o, d, visit)
+            })
         };
         self.render_colored_with(&tracer, film, pass, seed)
     }

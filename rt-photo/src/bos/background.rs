@@ -10,7 +10,8 @@ use alloc::vec::Vec;
 
 use rt_core::sampling::{rng_for, uniform_f64};
 
-use crate::bos::{BosError, ThinLens};
+use super::BosError;
+use crate::camera::ThinLens;
 use crate::math::{exp, floor};
 
 /// The background behind the flow.

@@ -11,8 +11,9 @@ use rt_volume::{
     trace, trace_beam, trace_visiting,
 };
 
-use crate::cutoff::Prepared;
-use crate::{Cutoff, CutoffError, Film, Photon, math};
+use super::cutoff::Prepared;
+use super::{Cutoff, CutoffError, Film, Photon};
+use crate::math;
 
 /// What the film records.
 #[derive(Clone, Debug, PartialEq)]

@@ -27,8 +27,8 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use super::sensor_error::{SensorError, check_image};
 use crate::math::{atan2, ceil, cos, sqrt};
-use crate::sensor::{SensorError, check_image};
 
 /// The first zero of `J₁`: the first dark ring at `x = 3.8317…`.
 const J1_ZERO_1: f64 = 3.831_705_970_207_512;

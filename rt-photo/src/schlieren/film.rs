@@ -3,7 +3,8 @@
 use alloc::vec::Vec;
 use core::fmt;
 
-use crate::{math, sheet};
+use super::sheet;
+use crate::math;
 
 /// The reconstruction filter.
 #[derive(Clone, Copy, Debug, PartialEq)]

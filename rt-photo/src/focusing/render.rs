@@ -47,7 +47,7 @@ use glam::DVec3;
 use rt_core::sampling::{rng_for, uniform_f64};
 use rt_volume::{GridField, IndexField, Octree, TraceError, TraceParams, TraceResult, trace};
 
-use crate::bos::{Frame, ThinLens};
+use crate::camera::{Frame, ThinLens};
 use crate::math::{atan2, cos, floor, sin, sqrt};
 
 /// The source grid: bright bands of width `duty · pitch`, `pitch` apart,
@@ -270,10 +270,7 @@ impl FocusingSchlieren {
     /// [`FocusingError::Camera`] or [`FocusingError::Setup`], naming the
     /// first bad setting.
     pub fn validate(&self) -> Result<(), FocusingError> {
-        self.camera.validate().map_err(|e| match e {
-            crate::BosError::Camera(w) => FocusingError::Camera(w),
-            _ => FocusingError::Camera("invalid"),
-        })?;
+        self.camera.validate().map_err(|e| FocusingError::Camera(e.0))?;
         let g = &self.grid;
         let why = if !(self.source_distance.is_finite()
             && self.source_distance > self.camera.focus_distance)
@@ -414,7 +411,7 @@ impl FocusingSchlieren {
         self.validate()?;
         let (w, h) = (self.camera.width, self.camera.height);
         let frame = self.camera.frame();
-        let rows = crate::bos::rows(h, |j| self.row(tracer, &frame, j, seed));
+        let rows = crate::rows::rows(h, |j| self.row(tracer, &frame, j, seed));
         let mut out = FocusingImages {
             width: w,
             height: h,

@@ -1,0 +1,11 @@
+//! Background-oriented schlieren: a camera looks through the flow at a
+//! background (random dots, a dot grid or an image); the rig it is set up
+//! as, chosen for the flow.
+
+mod background;
+mod render;
+mod rig;
+
+pub use background::{Background, DotBackground, DotGrid, ImageBackground};
+pub use render::{Bos, BosError, BosImages};
+pub use rig::{BosRig, BosRigOptions};
