@@ -4,7 +4,9 @@
 
 use glam::DVec3;
 
-use super::{State, TraceError, TraceStats, unit};
+use super::eval::State;
+use super::walk::unit;
+use super::{TraceError, TraceStats};
 
 /// A ray's whole integration state between two legs of a distributed
 /// trace ([`trace_begin`](crate::trace_begin), [`trace_leg`](crate::trace_leg)):
