@@ -25,6 +25,22 @@ pub struct Outputs {
     committed: bool,
 }
 
+/// Makes the folder `dir` if it is missing, and says so on stderr (a run
+/// that writes a folder of files of its own, as `rt demo` does).
+///
+/// # Errors
+/// `dir` cannot be made, or is a file.
+pub fn make_folder(dir: &Path) -> anyhow::Result<()> {
+    if !dir.exists() {
+        fs::create_dir_all(dir)
+            .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
+        eprintln!("rt: created folder {}", dir.display());
+    } else if !dir.is_dir() {
+        bail!("{}: is not a folder", dir.display());
+    }
+    Ok(())
+}
+
 impl Outputs {
     /// Refuses an `--out` that names a folder, for a run whose files are
     /// named after it (`<stem>-reference.png`, …) rather than written to it.

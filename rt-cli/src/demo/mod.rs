@@ -47,7 +47,7 @@ use rt_surface::{
 
 use crate::{
     image::{over_background, write_png},
-    output::Outputs,
+    output::{Outputs, make_folder},
     scenes,
 };
 
@@ -119,6 +119,7 @@ fn build_world(mesh: Mesh) -> anyhow::Result<SurfaceScene<'static>> {
 pub fn run(a: &Args) -> anyhow::Result<()> {
     let out = a.dir.as_path();
     // The folder made (and said) and checked before any work.
+    make_folder(out)?;
     let outs = Outputs::check(&[out.join("surface.png")])?;
     let mesh = terrain()?;
     // The terrain as a file, to try `rt view` on.
