@@ -6,20 +6,17 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use rt_photo::{
-    Background, Bos, BosRig, BosRigOptions, Cutoff, DotBackground, DotGrid, FilterImage,
-    ImageBackground, Mode, Sensor, ThinLens,
+    BosOptions, BosRig, BosRigOptions, BosSetup, FilterImage, Medium, Sensor, SetupError, units::si,
 };
-use rt_volume::io::{is_unstructured, read_grid};
 
 use crate::{
     figure::{Figure, Image, Legend, significant},
     image,
-    optics::{Axis, Interpolation, MeshOptions, Samples, Source, Volume},
+    optics::{self, Axis, Interpolation, MeshOptions, Samples},
     output::Outputs,
     parse,
-    units::si,
 };
 
 /// `rt bos FILE`: options.
@@ -129,14 +126,7 @@ pub struct Args {
 /// # Errors
 /// An unreadable or unsuitable volume, a bad set-up, an unwritable output.
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    if is_unstructured(&a.file) {
-        let mesh = a.mesh.load(&a.file, a.samples, false)?;
-        return render(&mesh, a).map(drop);
-    }
-    let grid = read_grid(&a.file)?;
-    let volume = Volume::new(grid, a.samples.quantity, a.samples.k, false, a.interp)
-        .with_context(|| a.file.display().to_string())?;
-    render(&volume, a)
+    render(&optics::open(&a.file, a.samples, false, a.interp, &a.mesh)?, a)
 }
 
 /// Renders `volume` as `a` says (its file and sample options aside),
@@ -144,7 +134,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 ///
 /// # Errors
 /// A bad set-up or an unwritable output.
-pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
+pub fn render(medium: &Medium, a: &Args) -> anyhow::Result<()> {
     let t = std::time::Instant::now();
     Outputs::refuse_folder(&a.out)?;
     let paths = [
@@ -160,10 +150,11 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     let mut targets = paths.to_vec();
     targets.extend([raw.clone(), raw.with_extension("json")]);
     let outs = Outputs::check(&targets)?;
-    let (bos, rig) = prepare(volume, a)?;
+    let setup = prepare(medium, a)?;
+    let (bos, rig) = (&setup.bos, &setup.rig);
     let camera = bos.camera;
     let (w, h) = (camera.width, camera.height);
-    let images = volume.bos(&bos, a.seed)?;
+    let images = setup.render(medium, a.seed)?;
     let sensor = Sensor {
         exposure: a.exposure,
         full_well: a.full_well,
@@ -182,7 +173,7 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     let max = sorted.last().copied().unwrap_or(0.0);
     let p99 = sorted[((sorted.len() - 1) as f64 * 0.99) as usize];
     let figure = outs.staging(&paths[2]);
-    displacement_figure(&images.displacement, (w32, h32), p99, max, (&rig, a.f_number), &figure)
+    displacement_figure(&images.displacement, (w32, h32), p99, max, (rig, a.f_number), &figure)
         .with_context(|| paths[2].display().to_string())?;
     let flat: Vec<f64> = images.displacement.iter().flatten().copied().collect();
     image::write_raw_f32(
@@ -262,77 +253,42 @@ fn displacement_figure(
     Ok(fig.write(path)?)
 }
 
-/// The BOS set-up `a` describes for `volume` (every render of `rt bos`,
-/// the demo and rtvis goes through here) and the rig it chose: the camera
-/// on the +axis side of the volume's centre looking back along −axis
-/// (light travels +axis, so the image's x runs along u as in `rt
-/// schlieren`), focused on the background `Z_D` behind the centre;
-/// lens, sensor and distances not given are chosen by [`BosRig::choose`]
-/// (`Z_D` from a survey of the flow's deflections); dots sized in pixels
-/// as imaged, an image read from its PNG; two-cell leapfrog steps through
-/// the field.
+/// The library's set-up for `a` ([`BosSetup::choose`]: the rig, camera
+/// and background chosen from the medium where `a` leaves them out), the
+/// background image read from its PNG.
 ///
 /// # Errors
-/// The volume closer to the lens than its focal length, an unreadable
-/// background image, or a bad set-up.
-pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<(Bos, BosRig)> {
-    let b = volume.bounds();
-    let (axis, u) = a.axis.frame();
-    let v = axis.cross(u);
-    let ext = b.max - b.min;
-    let w = a.size as usize;
-    let h = ((f64::from(a.size) * ext.dot(v) / ext.dot(u)).round() as usize).max(1);
-    let fixed = BosRigOptions {
-        focal_length: a.focal_length,
-        pixel_pitch: a.pixel,
-        camera_distance: a.distance,
-        background_distance: a.background_distance,
-    };
-    // Only a background distance left to choose needs the deflections.
-    let deflection = if a.background_distance.is_none() {
-        let survey = volume.survey(&volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0))?;
-        survey.magnitude(0.99)
-    } else {
-        0.0
-    };
-    let rig = BosRig::choose(&fixed, ext.dot(u), ext.dot(axis), w, deflection)?;
-    let (f, z_a, z_d) = (rig.focal_length, rig.camera_distance, rig.background_distance);
-    if z_a <= f {
-        bail!("the volume must be farther from the lens ({z_a} m) than its focal length ({f} m)");
-    }
-    let camera = ThinLens {
-        position: 0.5 * (b.min + b.max) + z_a * axis,
-        direction: -axis,
-        up: v,
-        focal_length: f,
-        f_number: a.f_number,
-        focus_distance: z_a + z_d,
-        pixel_pitch: rig.pixel_pitch,
-        width: w,
-        height: h,
-    };
-    let background: Background = match &a.background {
-        BackgroundChoice::Random => {
-            DotBackground::for_camera(&camera, a.dot, a.spacing, a.seed).into()
-        }
-        BackgroundChoice::Grid => DotGrid::for_camera(&camera, a.dot, a.spacing).into(),
+/// An unreadable background image, or what [`BosSetup::choose`] refuses.
+pub fn prepare(medium: &Medium, a: &Args) -> anyhow::Result<BosSetup> {
+    let background = match &a.background {
+        BackgroundChoice::Random => rt_photo::BackgroundChoice::Random,
+        BackgroundChoice::Grid => rt_photo::BackgroundChoice::Grid,
         BackgroundChoice::Image(path) => {
-            let img = image::read_luminance(path)?;
-            let px = a.background_pixel.unwrap_or(w as f64 / img.width as f64);
-            ImageBackground::for_camera(&camera, img.width, img.height, img.samples, px)
-                .with_context(|| path.display().to_string())?
-                .into()
+            rt_photo::BackgroundChoice::read_png(path, a.background_pixel)?
         }
     };
-    let bos = Bos {
-        camera,
-        background_distance: z_a + z_d,
+    let options = BosOptions {
+        axis: a.axis.into(),
+        size: a.size,
+        rig: BosRigOptions {
+            focal_length: a.focal_length,
+            pixel_pitch: a.pixel,
+            camera_distance: a.distance,
+            background_distance: a.background_distance,
+        },
+        f_number: a.f_number,
         background,
-        aperture_samples: a.samples_per_axis,
-        params: volume.params(),
+        dot: a.dot,
+        spacing: a.spacing,
+        samples_per_axis: a.samples_per_axis,
+        seed: a.seed,
     };
-    bos.validate()?;
-    Ok((bos, rig))
+    BosSetup::choose(medium, &options).map_err(|e| match &a.background {
+        BackgroundChoice::Image(path) if matches!(e, SetupError::Bos(_)) => {
+            anyhow::Error::new(e).context(path.display().to_string())
+        }
+        _ => e.into(),
+    })
 }
 
 /// What `--background` names.

@@ -5,16 +5,13 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
 use rt_photo::{
-    Cutoff, FocusingImages, FocusingRig, FocusingRigOptions, FocusingSchlieren, Mode, Sensor,
-    SourceGrid, ThinLens,
+    FocusingImages, FocusingOptions, FocusingRigOptions, FocusingSetup, Medium, Sensor,
 };
-use rt_volume::io::{is_unstructured, read_grid};
 
 use crate::{
     image,
-    optics::{Axis, Interpolation, MeshOptions, Samples, Source, Volume},
+    optics::{self, Axis, Interpolation, MeshOptions, Samples},
     output::Outputs,
     parse,
 };
@@ -127,14 +124,7 @@ pub struct Args {
 /// # Errors
 /// An unreadable or unsuitable volume, a bad set-up, an unwritable output.
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    if is_unstructured(&a.file) {
-        let mesh = a.mesh.load(&a.file, a.samples, false)?;
-        return render(&mesh, a).map(drop);
-    }
-    let grid = read_grid(&a.file)?;
-    let volume = Volume::new(grid, a.samples.quantity, a.samples.k, false, a.interp)
-        .with_context(|| a.file.display().to_string())?;
-    render(&volume, a).map(drop)
+    render(&optics::open(&a.file, a.samples, false, a.interp, &a.mesh)?, a).map(drop)
 }
 
 /// Renders `volume` as `a` says (its file and sample options aside),
@@ -142,15 +132,15 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
 ///
 /// # Errors
 /// A bad set-up or an unwritable output.
-pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<FocusingImages> {
+pub fn render(medium: &Medium, a: &Args) -> anyhow::Result<FocusingImages> {
     let t = std::time::Instant::now();
     let raw = a.out.with_extension("raw");
     // Before any work: an impossible --out fails now, not after the render.
     let outs = Outputs::check(&[a.out.clone(), raw.clone(), raw.with_extension("json")])?;
-    let (fs, rig) = prepare(volume, a)?;
-    let cam = fs.camera;
+    let setup = prepare(medium, a)?;
+    let cam = setup.system.camera;
     let (w, h) = (cam.width, cam.height);
-    let images = volume.focusing(&fs, a.seed)?;
+    let images = setup.render(medium, a.seed)?;
     let relative = images.relative();
     // The sensor records the light, scaled so that the undisturbed
     // background (the mean over the pixels the source lights) collects
@@ -182,72 +172,40 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<FocusingImages> 
     sorted.sort_by(f64::total_cmp);
     let p99 = sorted[((sorted.len() - 1) as f64 * 0.99) as usize];
     println!(
-        "wrote {}, {} ({w}×{h}, {} rays in {:.2} s; {rig}; cutoff offset {} pitch; |I/I₀ − 1| 99th percentile {p99:.3})",
+        "wrote {}, {} ({w}×{h}, {} rays in {:.2} s; {setup}; |I/I₀ − 1| 99th percentile {p99:.3})",
         a.out.display(),
         raw.with_extension("json").display(),
         w * h * (a.samples_per_axis * a.samples_per_axis) as usize,
         t.elapsed().as_secs_f64(),
-        fs.cutoff_offset,
     );
     Ok(images)
 }
 
-/// The set-up `a` describes for `volume` (`rt focusing`, the demo and
-/// rtvis go through here) and the rig it chose: the camera on the +axis
-/// side of the volume's centre looking back along −axis (light travels
-/// +axis, so the image's x runs along u as in `rt schlieren`), focused
-/// `--focus` toward the lens from the centre; lens, sensor, distances and
-/// the source grid's pitch not given are chosen by [`FocusingRig::choose`]
-/// (the pitch from a survey of the flow); two-cell leapfrog steps.
+/// The library's set-up for `a` ([`FocusingSetup::choose`]: the rig and
+/// grid chosen from the medium where `a` leaves them out).
 ///
 /// # Errors
-/// The focus plane closer to the lens than its focal length, the source
-/// grid not beyond it, or a bad set-up.
-pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<(FocusingSchlieren, FocusingRig)> {
-    let b = volume.bounds();
-    let (axis, u) = a.axis.frame();
-    let v = axis.cross(u);
-    let ext = b.max - b.min;
-    let w = a.size as usize;
-    let h = ((f64::from(a.size) * ext.dot(v) / ext.dot(u)).round() as usize).max(1);
-    let angle = a.angle.to_radians();
-    let fixed = FocusingRigOptions {
-        focal_length: a.focal_length,
-        aperture: a.aperture,
-        pixel_pitch: a.pixel,
-        camera_distance: a.distance,
-        source_distance: a.source_distance,
-        grid_pitch: a.pitch,
+/// What [`FocusingSetup::choose`] refuses.
+pub fn prepare(medium: &Medium, a: &Args) -> anyhow::Result<FocusingSetup> {
+    let options = FocusingOptions {
+        axis: a.axis.into(),
+        size: a.size,
+        rig: FocusingRigOptions {
+            focal_length: a.focal_length,
+            aperture: a.aperture,
+            pixel_pitch: a.pixel,
+            camera_distance: a.distance,
+            source_distance: a.source_distance,
+            grid_pitch: a.pitch,
+        },
+        focus: a.focus,
+        duty: a.duty,
+        angle: a.angle,
+        offset: a.offset,
+        bands: a.bands,
+        samples_per_axis: a.samples_per_axis,
     };
-    // Only a pitch left to choose needs the deflections.
-    let deflection = if a.pitch.is_none() {
-        let survey = volume.survey(&volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0))?;
-        survey.along(angle, 0.99)
-    } else {
-        0.0
-    };
-    let rig = FocusingRig::choose(&fixed, ext.dot(u), w, a.focus, a.offset, deflection)?;
-    let camera = ThinLens {
-        position: 0.5 * (b.min + b.max) + rig.camera_distance * axis,
-        direction: -axis,
-        up: v,
-        focal_length: rig.focal_length,
-        f_number: rig.focal_length / rig.aperture,
-        focus_distance: rig.focus_distance,
-        pixel_pitch: rig.pixel_pitch,
-        width: w,
-        height: h,
-    };
-    let fs = FocusingSchlieren {
-        camera,
-        source_distance: rig.source_distance,
-        grid: SourceGrid { pitch: rig.grid_pitch, duty: a.duty, angle, bands: a.bands },
-        cutoff_offset: a.offset,
-        aperture_samples: a.samples_per_axis,
-        params: volume.params(),
-    };
-    fs.validate()?;
-    Ok((fs, rig))
+    Ok(FocusingSetup::choose(medium, &options)?)
 }
 
 impl Args {

@@ -3,7 +3,7 @@
 use std::{
     fmt,
     fs::File,
-    io::{BufReader, BufWriter},
+    io::BufWriter,
     path::{Path, PathBuf},
 };
 
@@ -244,84 +244,6 @@ pub fn write_film16(film: &rt_photo::Film, color: bool, path: &Path) -> Result<(
         "rt: linear intensity; value / {RAW16_UNIT} = I/I0, I0 the undisturbed beam with nothing cut"
     );
     encode(path, (w, h), (kind, png::BitDepth::Sixteen), false, Some(&text), &data)
-}
-
-/// The most pixels [`read_luminance`] reads (4096 × 4096).
-const MAX_READ_PIXELS: u64 = 1 << 24;
-
-/// A grey image: `width × height` linear luminances in `[0, 1]`, rows top
-/// first.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Luminance {
-    /// Pixels per row.
-    pub width: usize,
-    /// Rows.
-    pub height: usize,
-    /// The samples, row-major.
-    pub samples: Vec<f64>,
-}
-
-/// Reads a PNG (grey or colour, 1–16 bits, palette included; alpha
-/// ignored) as linear luminance: samples decoded from sRGB, unless the
-/// file says it is linear (gAMA 1.0 and no sRGB chunk, as `rt` writes its
-/// counts), then `Y = 0.2126 R + 0.7152 G + 0.0722 B` (Rec. 709) for
-/// colour.
-///
-/// # Errors
-/// An unreadable or malformed file, or one of more than 4096² pixels,
-/// named by its path.
-pub fn read_luminance(path: &Path) -> anyhow::Result<Luminance> {
-    let what = || path.display().to_string();
-    let file = File::open(path).with_context(what)?;
-    let mut decoder = png::Decoder::new(BufReader::new(file));
-    decoder.set_transformations(png::Transformations::EXPAND);
-    let mut reader = decoder.read_info().with_context(what)?;
-    let info = reader.info();
-    let (w, h) = (info.width, info.height);
-    if u64::from(w) * u64::from(h) > MAX_READ_PIXELS {
-        bail!("{}: {w}×{h} pixels, at most {MAX_READ_PIXELS} read", what());
-    }
-    let linear = info.srgb.is_none()
-        && info.source_gamma.is_some_and(|g| (g.into_value() - 1.0).abs() < 0.01);
-    let mut buf = vec![0; reader.output_buffer_size()];
-    let frame = reader.next_frame(&mut buf).with_context(what)?;
-    let channels = match frame.color_type {
-        png::ColorType::Grayscale => 1,
-        png::ColorType::GrayscaleAlpha => 2,
-        png::ColorType::Rgb => 3,
-        png::ColorType::Rgba => 4,
-        png::ColorType::Indexed => bail!("{}: palette not expanded", what()),
-    };
-    let wide = frame.bit_depth == png::BitDepth::Sixteen;
-    let decode = |c: f64| if linear { c } else { srgb_to_linear(c) };
-    let (wu, hu) = (w as usize, h as usize);
-    let mut samples = Vec::with_capacity(wu * hu);
-    for row in buf[..frame.buffer_size()].chunks_exact(frame.line_size).take(hu) {
-        for x in 0..wu {
-            let at = |c: usize| {
-                let i = x * channels + c;
-                if wide {
-                    f64::from(u16::from_be_bytes([row[2 * i], row[2 * i + 1]])) / 65535.0
-                } else {
-                    f64::from(row[i]) / 255.0
-                }
-            };
-            samples.push(if channels < 3 {
-                decode(at(0))
-            } else {
-                0.2126 * decode(at(0)) + 0.7152 * decode(at(1)) + 0.0722 * decode(at(2))
-            });
-        }
-    }
-    if samples.len() != wu * hu {
-        bail!("{}: the image data is short", what());
-    }
-    Ok(Luminance { width: wu, height: hu, samples })
-}
-
-/// The sRGB decoding (IEC 61966-2-1) of `c ∈ [0, 1]`.
-fn srgb_to_linear(c: f64) -> f64 {
-    if c <= 0.040_45 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }
 
 /// Writes `data` (`components` values per pixel, `width × height` pixels,

@@ -3,19 +3,18 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use rt_photo::Cell;
-use rt_photo::{Cutoff, Mode};
+use rt_photo::{
+    Bench, Cell, Cutoff, Medium, MeshTrace, Mode, Survey,
+    units::{index, si, sig3},
+};
 use rt_surface::io::{MeshData, read_mesh};
 use rt_volume::{
-    GridSamples,
+    GridSamples, Interp,
     glam::DVec3,
     io::{is_unstructured, read_grid_samples, read_unstructured},
 };
 
-use crate::{
-    optics::{Axis, Interpolation, MeshTrace, MeshVolume, Samples, Source, Survey, Volume},
-    units::{index, si, sig3},
-};
+use crate::optics::{Axis, Samples};
 
 /// `rt info FILE`: options.
 #[derive(Debug, clap::Args)]
@@ -113,12 +112,13 @@ fn volume(a: &Args, samples: GridSamples) -> anyhow::Result<String> {
             sig3(f64::from(fill))
         );
     }
-    let v = Volume::new(g, a.samples.quantity, a.samples.k, true, Interpolation::Linear)
+    let v = Medium::from_grid(g, a.samples.into(), true, Interp::Trilinear)
         .context("preparing the deflection survey")?;
-    text +=
-        &format!("index {}\n", range(v.field.grid().data().iter().map(|&n| f64::from(n)), true));
-    let bench = v.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
-    text += &survey_line(a, &v.survey(&bench)?);
+    if let Medium::Grid(g) = &v {
+        let index = g.field().grid().data().iter().map(|&n| f64::from(n));
+        text += &format!("index {}\n", range(index, true));
+    }
+    text += &survey_line(a, &v)?;
     Ok(text)
 }
 
@@ -166,31 +166,47 @@ fn unstructured(a: &Args) -> anyhow::Result<String> {
         if data.from_cells { ", averaged to the points" } else { "" },
         range(data.values.iter().copied(), false),
     );
-    let v = MeshVolume::new(data, a.samples.quantity, a.samples.k, true, MeshTrace::Exact)
-        .context("preparing the deflection survey")?;
-    let m = v.mesh();
+    let (points, values) = (data.points, data.values);
+    let v = Medium::from_mesh(
+        points,
+        &data.cells,
+        values,
+        a.samples.into(),
+        true,
+        &data.array,
+        MeshTrace::Exact,
+    )
+    .context("preparing the deflection survey")?;
+    let m = v.mesh().context("a mesh read as a grid")?;
     text += &format!(
         "split into {} tetrahedra, {} boundary faces\nindex {}\n",
         m.tetrahedra().len(),
         m.boundary_faces(),
         range(m.index().iter().copied(), true),
     );
-    let bench = v.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
-    text += &survey_line(a, &v.survey(&bench)?);
+    text += &survey_line(a, &v)?;
     Ok(text)
 }
 
 /// The survey's line of `rt info`.
-fn survey_line(a: &Args, survey: &Survey) -> String {
+fn survey_line(a: &Args, medium: &Medium) -> anyhow::Result<String> {
+    let probe = Bench::through(
+        medium.bounds(),
+        a.axis.into(),
+        Mode::Schlieren(Cutoff::None),
+        0.0,
+        medium.params(),
+    );
+    let survey = Survey::of(medium, &probe, Survey::WIDTH)?;
     let rad = |x: f64| if x == 0.0 { "0 rad".to_string() } else { si(x, "rad") };
-    format!(
+    Ok(format!(
         "deflection along {} (one photon per pixel of a {}-wide survey): |ε| median {}, 99th percentile {}, max {}\n",
         format!("{:?}", a.axis).to_lowercase(),
         survey.width,
         rad(survey.magnitude(0.5)),
         rad(survey.magnitude(0.99)),
         rad(survey.magnitude(1.0)),
-    )
+    ))
 }
 
 fn mesh(path: &Path, m: &MeshData) -> String {

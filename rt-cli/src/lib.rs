@@ -43,7 +43,7 @@ mod progress;
 pub mod scenes;
 pub mod schlieren;
 pub mod text;
-pub mod units;
+pub use rt_photo::units;
 pub mod view;
 pub mod vtu;
 

@@ -27,7 +27,7 @@ where
 }
 
 /// The largest image edge the tools accept, in pixels.
-pub(crate) const MAX_EDGE: u32 = 16384;
+pub(crate) use rt_photo::MAX_EDGE;
 
 /// `WxH` in pixels, each in `1..=MAX_EDGE`.
 pub(crate) fn size(s: &str) -> Result<(u32, u32), String> {

@@ -1,24 +1,23 @@
 //! `rt schlieren`: synthetic schlieren, shadowgraph, interferogram or
 //! colour schlieren of a volume file, with automatic exposure.
 
-use std::path::PathBuf;
+use std::{path::PathBuf, time::Instant};
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use clap::ValueEnum;
 use rt_core::Frame;
-use rt_photo::{Bench, Cutoff, Film, FilterImage, Mode, Reconstruction};
-use rt_volume::{
-    glam::DVec3,
-    io::{is_unstructured, read_grid},
+use rt_photo::{
+    Cutoff, CutoffKind as Kind, Film, Medium, Mode, Reconstruction, SchlierenOptions,
+    SchlierenSetup, traced_per_pixel, units::si,
 };
+use rt_volume::glam::DVec3;
 
 use crate::{
     figure::{self, Figure, Legend},
     image,
-    optics::{Axis, Interpolation, MeshOptions, Samples, Source, Survey, Volume},
+    optics::{self, Axis, Interpolation, MeshOptions, Samples},
     output::Outputs,
-    parse,
-    units::{index, si, sig3},
+    parse, progress,
 };
 
 /// The optical set-up.
@@ -99,7 +98,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Axis::Z)]
     pub axis: Axis,
     /// Image width in pixels (height follows the volume's aspect).
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=i64::from(parse::MAX_EDGE)))]
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=i64::from(rt_photo::MAX_EDGE)))]
     pub size: u32,
     /// Photons per pixel. Each pass traces a k×k lattice of photons per
     /// pixel (k = 2 up to 63 photons, 4 from 64, 8 from 256: at least four
@@ -156,68 +155,35 @@ pub enum Estimator {
     Photons,
 }
 
-/// The most photons one run may trace.
-const MAX_PHOTONS: u64 = 1 << 36;
-
-/// The cutoff or mode for `args`, its parameters chosen from `survey` where
-/// the user left them out; returns a line saying what was chosen.
-fn optics(a: &Args, survey: &Survey, fine: Option<&Survey>, n_ref: f64) -> (Mode, f64, String) {
-    let angle = a.angle.to_radians();
-    // Knife edge and graded filter: 0.5 ± 0.45 at the 99th percentile.
-    let eps_perp = survey.along(angle, 0.99).max(1e-12);
-    let eps = survey.magnitude(0.99).max(1e-12);
-    let f = a.f;
-    let film = a.film_distance.unwrap_or(0.0);
-    match a.cutoff {
-        CutoffKind::Knife => {
-            let h = a.h.unwrap_or(f * eps_perp / 0.45);
-            let mode = Mode::Schlieren(Cutoff::KnifeEdge { angle, offset: 0.0, f, h });
-            let what =
-                format!("knife edge at {}°, f = {}, h = {}", sig3(a.angle), si(f, "m"), si(h, "m"));
-            (mode, film, what)
-        }
-        CutoffKind::Graded => {
-            let width = a.h.unwrap_or(f * eps_perp / 0.45);
-            let mode = Mode::Schlieren(Cutoff::Graded { angle, f, width });
-            let what = format!(
-                "graded filter at {}°, f = {}, width = {}",
-                sig3(a.angle),
-                si(f, "m"),
-                si(width, "m")
-            );
-            (mode, film, what)
-        }
-        CutoffKind::Pinhole | CutoffKind::DarkField => {
-            let radius = a.radius.unwrap_or(0.25 * f * eps);
-            let dark_field = a.cutoff == CutoffKind::DarkField;
-            let mode = Mode::Schlieren(Cutoff::Pinhole { f, radius, dark_field });
-            let what = if dark_field { "dark-field stop" } else { "pinhole" };
-            (mode, film, format!("{what}, f = {}, radius = {}", si(f, "m"), si(radius, "m")))
-        }
-        CutoffKind::Color => {
-            // The rim clears 99.5 % of the disturbed pixels of a survey at
-            // the image's resolution: what lies beyond it is cut (black).
-            let chosen = || fine.unwrap_or(survey).disturbed_magnitude(0.995).max(1e-12);
-            let half = a.half_range.unwrap_or_else(chosen);
-            let mode = Mode::Schlieren(Cutoff::Color(FilterImage::hue_wheel(256, half)));
-            (mode, film, format!("colour filter, rim at |ε| = {}", si(half, "rad")))
-        }
-        CutoffKind::None => {
-            let div = survey.divergence(0.99);
-            let l = a.film_distance.unwrap_or(if div > 0.0 { 0.5 / div } else { 0.0 });
-            (Mode::Schlieren(Cutoff::None), l, format!("no cutoff, film distance = {}", si(l, "m")))
-        }
-        CutoffKind::Interferometry => {
-            let mode = Mode::Interferometry { lambda: a.lambda, n_ref, fringe_spacing: a.fringes };
-            let fringes = a
-                .fringes
-                .map_or("infinite fringe".to_string(), |s| format!("fringes {} apart", si(s, "m")));
-            let what = format!(
-                "interferometry, λ = {}, n_ref = {}, {fringes}",
-                si(a.lambda, "m"),
-                index(n_ref)
-            );
-            (mode, film, what)
+impl Args {
+    /// The library's options for these arguments.
+    #[must_use]
+    pub fn options(&self) -> SchlierenOptions {
+        SchlierenOptions {
+            cutoff: match self.cutoff {
+                CutoffKind::Knife => Kind::Knife,
+                CutoffKind::Graded => Kind::Graded,
+                CutoffKind::Pinhole => Kind::Pinhole,
+                CutoffKind::DarkField => Kind::DarkField,
+                CutoffKind::Color => Kind::Color,
+                CutoffKind::None => Kind::None,
+                CutoffKind::Interferometry => Kind::Interferometry,
+            },
+            angle: self.angle,
+            f: self.f,
+            h: self.h,
+            radius: self.radius,
+            half_range: self.half_range,
+            wavelength: self.lambda,
+            fringes: self.fringes,
+            film_distance: self.film_distance,
+            axis: self.axis.into(),
+            size: self.size,
+            photons: self.photons,
+            reconstruction: match self.estimator {
+                Estimator::Sheet => Reconstruction::Sheet,
+                Estimator::Photons => Reconstruction::Photons,
+            },
         }
     }
 }
@@ -228,63 +194,15 @@ fn optics(a: &Args, survey: &Survey, fine: Option<&Survey>, n_ref: f64) -> (Mode
 /// An unreadable or unsuitable volume, bad optics, too many photons, an
 /// unwritable output.
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    if is_unstructured(&a.file) {
-        return render(&a.mesh.load(&a.file, a.samples, a.allow_nonphysical)?, a);
-    }
-    let grid = read_grid(&a.file)?;
-    let volume = Volume::new(grid, a.samples.quantity, a.samples.k, a.allow_nonphysical, a.interp)
-        .with_context(|| a.file.display().to_string())?;
-    render(&volume, a)
+    render(&optics::open(&a.file, a.samples, a.allow_nonphysical, a.interp, &a.mesh)?, a)
 }
 
-/// The bench `a` describes for `volume`, its optics chosen from a survey
-/// of the deflections where `a` leaves them out, and a line saying what
-/// was chosen (every user-facing render goes through here: the CLI, the
-/// demo, the report's noise measurement).
-///
-/// # Errors
-/// Too many photons for one run; a failing survey.
-pub fn prepare(volume: &impl Source, a: &Args) -> anyhow::Result<(Bench, String)> {
-    let probe = volume.bench(a.axis, Mode::Schlieren(Cutoff::None), 0.0);
-    let height = ((f64::from(a.size)) * probe.height / probe.width).round().max(1.0);
-    let photons = u64::from(a.size) * height as u64 * crate::optics::traced_per_pixel(a.photons);
-    if photons > MAX_PHOTONS {
-        bail!(
-            "{photons} photons is more than one run traces ({MAX_PHOTONS}); lower --size or --photons"
-        );
-    }
-    let survey = volume.survey(&probe)?;
-    let n_ref = volume.n_ref();
-    // A colour filter's rim must clear the peaks a coarse survey smooths
-    // away: survey it at the image's resolution (up to 512 pixels across,
-    // one photon each: a fraction of the render's photons).
-    let fine = if a.cutoff == CutoffKind::Color && a.half_range.is_none() {
-        Some(volume.survey_at(&probe, (a.size as usize).min(512))?)
-    } else {
-        None
-    };
-    let (mode, film_distance, chosen) = optics(a, &survey, fine.as_ref(), n_ref);
-    if let Mode::Interferometry { lambda, fringe_spacing, .. } = mode {
-        // Phase step per pixel: the deflection is the phase gradient over k.
-        let pixel = probe.width / f64::from(a.size);
-        let tau = std::f64::consts::TAU;
-        let step = tau / lambda * survey.magnitude(0.99) * pixel
-            + fringe_spacing.map_or(0.0, |s| tau * pixel / s);
-        if step > std::f64::consts::PI {
-            eprintln!(
-                "rt: warning: fringes alias: up to {step:.1} rad of phase per pixel (> π); raise --size or --lambda"
-            );
-        }
-    }
-    Ok((volume.bench(a.axis, mode, film_distance), chosen))
-}
-
-/// Renders `volume` as `a` says (its file and sample options aside) and
+/// Renders `medium` as `a` says (its file and sample options aside) and
 /// writes the PNG; prints one summary line.
 ///
 /// # Errors
 /// Bad optics, too many photons, an unwritable output.
-pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
+pub fn render(medium: &Medium, a: &Args) -> anyhow::Result<()> {
     let mut targets = vec![a.out.clone()];
     if a.raw16 {
         targets.push(image::beside(&a.out, "16bit"));
@@ -294,12 +212,17 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     }
     // Before any work: an impossible --out fails now, not after the render.
     let outs = Outputs::check(&targets)?;
-    let (bench, chosen) = prepare(volume, a)?;
-    let bench = match a.estimator {
-        Estimator::Sheet => bench,
-        Estimator::Photons => Bench { reconstruction: Reconstruction::Photons, ..bench },
-    };
-    let (film, seconds) = volume.render(&bench, a.size as usize, a.photons, a.seed)?;
+    let setup = SchlierenSetup::choose(medium, &a.options()).map_err(optics::hint)?;
+    if let Some(w) = &setup.warning {
+        eprintln!("rt: warning: {w}; raise --size or --lambda");
+    }
+    let (w, h) = setup.size;
+    let bar = progress::bar((w * h) as u64 * traced_per_pixel(a.photons), "photons");
+    let t = Instant::now();
+    let film = setup.render(medium, a.seed, &mut |done, _| bar.set_position(done))?;
+    let seconds = t.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let bench = &setup.bench;
     let scale = if matches!(bench.mode, Mode::Schlieren(Cutoff::None)) { 0.5 } else { 1.0 };
     let frame = image::film_frame(&film, scale)?;
     image::write_png(&frame, &outs.staging(&a.out))?;
@@ -309,12 +232,12 @@ pub fn render(volume: &impl Source, a: &Args) -> anyhow::Result<()> {
     }
     if !a.no_figure {
         let path = image::beside(&a.out, "figure");
-        figure(volume, a, &bench, &frame, &chosen)
+        figure(medium, a, &setup, &frame)
             .write(&outs.staging(&path))
             .with_context(|| path.display().to_string())?;
     }
     outs.commit()?;
-    println!("{}", summary(&targets, &film, seconds, &chosen));
+    println!("{}", summary(&targets, &film, seconds, &setup.to_string()));
     Ok(())
 }
 
@@ -333,8 +256,9 @@ fn axis_name(d: DVec3) -> &'static str {
 /// The figure of `frame`: axes from the volume's bounds along the image
 /// axes u and v, the mode and optics in the title, the colour filter's
 /// wheel as its legend.
-fn figure(volume: &impl Source, a: &Args, bench: &Bench, frame: &Frame, chosen: &str) -> Figure {
-    let b = volume.bounds();
+fn figure(medium: &Medium, a: &Args, setup: &SchlierenSetup, frame: &Frame) -> Figure {
+    let bench = &setup.bench;
+    let b = medium.bounds();
     let v = bench.direction.cross(bench.u);
     // The image spans the box's cross-section: u left to right, v bottom
     // to top (the box's coordinates along each, whatever the axis's sign).
@@ -346,16 +270,7 @@ fn figure(volume: &impl Source, a: &Args, bench: &Bench, frame: &Frame, chosen: 
         figure::Axis { name: axis_name(bench.u).into(), range: span(bench.u) },
         figure::Axis { name: axis_name(v).into(), range: span(v) },
     );
-    let mode = match a.cutoff {
-        CutoffKind::Knife => "Knife-edge schlieren",
-        CutoffKind::Graded => "Graded-filter schlieren",
-        CutoffKind::Pinhole => "Pinhole (bright-field) schlieren",
-        CutoffKind::DarkField => "Dark-field schlieren",
-        CutoffKind::Color => "Colour schlieren",
-        CutoffKind::None if bench.film_distance != 0.0 => "Shadowgraph",
-        CutoffKind::None => "Transmission (no cutoff)",
-        CutoffKind::Interferometry => "Interferogram",
-    };
+    let mode = setup.title();
     let file = a
         .file
         .file_name()
@@ -368,10 +283,7 @@ fn figure(volume: &impl Source, a: &Args, bench: &Bench, frame: &Frame, chosen: 
     Figure {
         image: figure::Image::from_frame(frame),
         title: format!("{mode}: {file}, beam along {along}{}", axis_name(bench.direction)),
-        subtitle: format!(
-            "{chosen}; {} photons per pixel",
-            crate::optics::traced_per_pixel(a.photons)
-        ),
+        subtitle: format!("{setup}; {} photons per pixel", traced_per_pixel(a.photons)),
         axes: Some(axes),
         legend,
     }

@@ -37,6 +37,7 @@
 //! | `std` | yes | float functions from std (here, in `rt-volume` and `rt-core`) |
 //! | `libm` | no | float functions from `libm` for `no_std` builds |
 //! | `parallel` | no | rows traced and films splatted with rayon (implies `std`); images stay bit-identical |
+//! | `png` | no | [`BackgroundChoice::read_png`]: BOS background images from PNG files (implies `std`) |
 //! | `mesh` | no | unstructured meshes (`rt_volume::UnstructuredField`) on every optical system: `Bench::render_mesh`, `Bos::render_mesh`, `FocusingSchlieren::render_mesh` (implies `std`) |
 //!
 //! Without `std`, one of `std` or `libm` must be on; an allocator is always
@@ -88,11 +89,16 @@ mod bos;
 mod camera;
 mod focusing;
 mod math;
+mod medium;
 #[cfg(feature = "mesh")]
 mod mesh;
 mod rows;
 mod schlieren;
+mod setup;
+pub mod units;
 
+#[cfg(feature = "png")]
+pub use bos::PngError;
 pub use bos::{
     Background, Bos, BosError, BosImages, BosRig, BosRigOptions, DotBackground, DotGrid,
     ImageBackground,
@@ -105,13 +111,19 @@ pub use schlieren::{
     Bench, BenchError, Cutoff, CutoffError, CutoffParam, Film, FilmError, Filter, FilterImage,
     Mode, Photon, Reconstruction, Weighting,
 };
+pub use setup::{
+    Axis, BackgroundChoice, BosOptions, BosSetup, CutoffKind, FocusingOptions, FocusingSetup,
+    MAX_EDGE, MAX_PHOTONS, SchlierenOptions, SchlierenSetup, SetupError, Survey, lattice,
+    traced_per_pixel,
+};
 // The types in this crate's signatures, from the crates below it (and
 // `build_octree`, the only way to the `Octree` that `render_grid` takes).
 pub use rt_core::ColorMap;
 #[cfg(feature = "mesh")]
 pub use rt_volume::{Cell, MeshError, SmoothField, UnstructuredField};
 pub use rt_volume::{
-    GridField, IndexField, Octree, TraceError, TraceParams, TraceResult, build_octree,
+    GridField, GridMedium, IndexField, Medium, MediumError, MeshTrace, Octree, Samples, TraceError,
+    TraceParams, TraceResult, build_octree,
 };
 
 /// The whole of `rt-volume`: analytic and gridded fields, integrators,

@@ -34,6 +34,22 @@ mod imp {
     pub(crate) fn exp(x: f64) -> f64 {
         x.exp()
     }
+    #[inline]
+    pub(crate) fn log10(x: f64) -> f64 {
+        x.log10()
+    }
+    #[inline]
+    pub(crate) fn round(x: f64) -> f64 {
+        x.round()
+    }
+    #[inline]
+    pub(crate) fn powi(x: f64, n: i32) -> f64 {
+        x.powi(n)
+    }
+    #[inline]
+    pub(crate) fn hypot(x: f64, y: f64) -> f64 {
+        x.hypot(y)
+    }
 }
 
 #[cfg(all(not(feature = "std"), feature = "libm"))]
@@ -69,6 +85,22 @@ mod imp {
     #[inline]
     pub(crate) fn exp(x: f64) -> f64 {
         libm::exp(x)
+    }
+    #[inline]
+    pub(crate) fn log10(x: f64) -> f64 {
+        libm::log10(x)
+    }
+    #[inline]
+    pub(crate) fn round(x: f64) -> f64 {
+        libm::round(x)
+    }
+    #[inline]
+    pub(crate) fn powi(x: f64, n: i32) -> f64 {
+        libm::pow(x, f64::from(n))
+    }
+    #[inline]
+    pub(crate) fn hypot(x: f64, y: f64) -> f64 {
+        libm::hypot(x, y)
     }
 }
 

@@ -67,6 +67,8 @@ mod grid;
 pub mod io;
 mod mapping;
 mod math;
+#[cfg(feature = "alloc")]
+mod medium;
 #[cfg(feature = "mesh")]
 pub mod mesh;
 #[cfg(feature = "alloc")]
@@ -87,6 +89,10 @@ pub use field::{Bounds, IndexField};
 #[cfg(feature = "alloc")]
 pub use grid::{Grid, GridError, GridField, GridSamples, Interp};
 pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
+#[cfg(feature = "io")]
+pub use medium::MediumOptions;
+#[cfg(feature = "alloc")]
+pub use medium::{GridMedium, Medium, MediumError, MeshTrace, Samples};
 #[cfg(feature = "mesh")]
 pub use mesh::{Cell, MeshError, SmoothField, UnstructuredField};
 #[cfg(feature = "alloc")]

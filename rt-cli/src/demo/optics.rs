@@ -7,14 +7,10 @@ use std::path::Path;
 use anyhow::Context;
 use rt_volume::io;
 
-use rt_photo::Cell;
-use rt_volume::{GLADSTONE_DALE_AIR, glam::DVec3};
+use rt_photo::{Cell, Medium, MeshTrace, Samples};
+use rt_volume::{Interp, glam::DVec3};
 
-use crate::{
-    bos, focusing,
-    optics::{Interpolation, MeshTrace, MeshVolume, Quantity, Volume},
-    schlieren, vtu,
-};
+use crate::{bos, focusing, schlieren, vtu};
 
 const RAW: &[u8] = include_bytes!("../../data/blast_sedov_64.raw");
 const JSON: &str = include_str!("../../data/blast_sedov_64.json");
@@ -24,18 +20,18 @@ const JSON: &str = include_str!("../../data/blast_sedov_64.json");
 ///
 /// # Errors
 /// None in practice (the data are built in and valid).
-pub fn blast_wave() -> anyhow::Result<Volume> {
-    blast_wave_with(Interpolation::Cubic)
+pub fn blast_wave() -> anyhow::Result<Medium> {
+    blast_wave_with(Interp::CatmullRom)
 }
 
 /// [`blast_wave`] with the interpolant `interp`.
 ///
 /// # Errors
 /// None in practice (the data are built in and valid).
-pub fn blast_wave_with(interp: Interpolation) -> anyhow::Result<Volume> {
+pub fn blast_wave_with(interp: Interp) -> anyhow::Result<Medium> {
     let header: serde_json::Value = serde_json::from_str(JSON).context("built-in JSON header")?;
     let grid = io::parse_raw_json(&header, RAW).context("built-in blast wave")?;
-    Volume::density(grid, interp)
+    Ok(Medium::from_grid(grid, Samples::AIR, false, interp)?)
 }
 
 /// Writes the built-in blast wave into `dir` as raw + JSON (for tools
@@ -87,9 +83,8 @@ pub(crate) fn render_all(out: &Path) -> anyhow::Result<()> {
     let vtu = out.join("blast.vtu");
     let (points, cells, density) = blast_mesh()?;
     vtu::write_vtu(&vtu, &points, &cells, "density", &density)?;
-    let data = io::read_unstructured(&vtu, None).context("blast.vtu")?;
-    let mesh =
-        MeshVolume::new(data, Quantity::Density, GLADSTONE_DALE_AIR, false, MeshTrace::Smooth)?;
+    let options = rt_volume::MediumOptions { mesh: MeshTrace::Smooth, ..Default::default() };
+    let mesh = Medium::open(&vtu, &options)?;
     let args = ["--cutoff", "knife", "--size", "256", "--photons", "4", "--mesh", "smooth"];
     let mut a = schlieren::Args::from_args(&vtu, args)?;
     a.out = out.join("schlieren-mesh.png");

@@ -163,12 +163,8 @@ impl Args {
         };
         Ok(volume::VolumeJob {
             file,
-            quantity: self.samples.quantity,
-            k: self.samples.k,
-            interp: match self.interp {
-                Interpolation::Linear => rt_volume::Interp::Trilinear,
-                Interpolation::Cubic => rt_volume::Interp::CatmullRom,
-            },
+            samples: self.samples.into(),
+            interp: self.interp.into(),
             optics: match self.record {
                 Record::Knife => volume::VolumeOptics::Knife,
                 Record::Interferometry => volume::VolumeOptics::Interferometry {

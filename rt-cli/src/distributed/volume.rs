@@ -45,14 +45,12 @@ use rt_composite::{
     Communicator,
     exchange::{ExchangeStats, all_gather, rounds},
 };
-use rt_photo::{Bench, Cutoff, Film, Filter, Mode, Reconstruction, Weighting};
+use rt_photo::{Axis, Bench, Cutoff, Film, Filter, Mode, Reconstruction, Weighting};
 use rt_volume::{
-    Begin, BrickField, Bricks, Exit, Grid, GridField, GridInfo, Interp, Leg, PathState,
-    TraceParams, TraceResult, TraceStats, gladstone_dale, glam::DVec3, io, step_reach, trace,
-    trace_begin, trace_leg,
+    Begin, BrickField, Bricks, Exit, Grid, GridField, GridInfo, Interp, Leg, PathState, Samples,
+    TraceParams, TraceResult, TraceStats, glam::DVec3, io, step_reach, trace, trace_begin,
+    trace_leg,
 };
-
-use crate::optics::Quantity;
 
 /// Photons a rank advances per round, and most results it sends rank 0
 /// per round, by default: this bounds its message buffers (see
@@ -95,9 +93,7 @@ pub struct VolumeJob {
     /// brick at a time).
     pub file: PathBuf,
     /// What the samples are.
-    pub quantity: Quantity,
-    /// Gladstone–Dale constant in m³/kg (for densities).
-    pub k: f64,
+    pub samples: Samples,
     /// The interpolant.
     pub interp: Interp,
     /// What is recorded.
@@ -124,8 +120,7 @@ impl VolumeJob {
         let file = crate::demo::write_blast_wave(dir)?;
         Ok(Self {
             file,
-            quantity: Quantity::Density,
-            k: rt_volume::GLADSTONE_DALE_AIR,
+            samples: Samples::AIR,
             interp: Interp::CatmullRom,
             optics: VolumeOptics::Knife,
             size,
@@ -144,23 +139,13 @@ impl VolumeJob {
         2 + 8 + batch * PHOTON_BYTES + 8 + batch * RESULT_BYTES
     }
 
-    fn to_index(&self, grid: Grid) -> anyhow::Result<Grid> {
-        Ok(match self.quantity {
-            Quantity::Density => {
-                let k = self.k;
-                if !(k.is_finite() && k > 0.0) {
-                    bail!("the Gladstone–Dale constant must be finite and > 0 (got {k})");
-                }
-                grid.map(|rho| gladstone_dale(f64::from(rho), k) as f32)?
-            }
-            Quantity::Index => grid,
-        })
-    }
-
     /// The samples `lo..hi` of the file, as index.
     fn read_box(&self, lo: [usize; 3], hi: [usize; 3]) -> anyhow::Result<Grid> {
         let grid = io::read_grid_box(&self.file, lo, hi)?;
-        self.to_index(grid).with_context(|| self.file.display().to_string())
+        // Non-physical samples are the user's to judge here (the ranks
+        // read bricks, not the whole volume's range).
+        let grid = self.samples.grid_to_index(grid, true);
+        grid.with_context(|| self.file.display().to_string())
     }
 
     /// The whole grid's header, and the index outside the volume (its
@@ -196,13 +181,7 @@ impl VolumeJob {
                 Mode::Interferometry { lambda, n_ref: ambient, fringe_spacing: fringes }
             }
         };
-        let bench = crate::optics::bench_through(
-            info.bounds(),
-            crate::optics::Axis::Z,
-            mode,
-            0.0,
-            Self::params(info),
-        );
+        let bench = Bench::through(info.bounds(), Axis::Z, mode, 0.0, Self::params(info));
         Bench {
             strata: self.strata,
             weighting: Weighting::Weight,

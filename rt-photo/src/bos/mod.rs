@@ -3,9 +3,13 @@
 //! as, chosen for the flow.
 
 mod background;
+#[cfg(feature = "png")]
+mod png_image;
 mod render;
 mod rig;
 
 pub use background::{Background, DotBackground, DotGrid, ImageBackground};
+#[cfg(feature = "png")]
+pub use png_image::PngError;
 pub use render::{Bos, BosError, BosImages};
 pub use rig::{BosRig, BosRigOptions};

@@ -425,8 +425,21 @@ impl Bench {
         pass: u64,
         seed: u64,
     ) -> Result<(), BenchError> {
+        self.render_grid_with(field, tree, &self.params, film, pass, seed)
+    }
+
+    /// [`Bench::render_grid`] with the trace settings `params`.
+    pub(crate) fn render_grid_with(
+        &self,
+        field: &GridField,
+        tree: &Octree,
+        params: &TraceParams,
+        film: &mut Film,
+        pass: u64,
+        seed: u64,
+    ) -> Result<(), BenchError> {
         if field.interp() != tree.interp() {
-            return self.render(field, film, pass, seed);
+            return self.render_with(&|o, d| trace(field, o, d, params), film, pass, seed);
         }
         self.validate()?;
         let window = BeamWindow {
@@ -438,12 +451,7 @@ impl Bench {
         };
         let mask = BeamMask::build(field, tree, &window, self.skip_tolerance(field, film))
             .map_err(BenchError::Trace)?;
-        self.render_with(
-            &|o, d| trace_beam(field, tree, &mask, o, d, &self.params),
-            film,
-            pass,
-            seed,
-        )
+        self.render_with(&|o, d| trace_beam(field, tree, &mask, o, d, params), film, pass, seed)
     }
 
     /// [`Bench::render`] with any tracer `(origin, direction) → result`,

@@ -1,9 +1,13 @@
 //! Numbers as a paper prints them: SI prefixes and three significant
 //! digits (`10.6 µm`, `2.90 mm`, `169 k photons/s`), refractive indices to
-//! the digit that shows their departure from 1 (`1.000637`), rates
-//! rounded. Every line the tool prints and every figure title goes
-//! through here, never `{}` of a raw `f64` (`0.0000106 m`,
-//! `1.0006369352340698`).
+//! the digit that shows their departure from 1 (`1.000637`). The lines
+//! the set-ups print ([`crate::SchlierenSetup`]'s `Display`) and the
+//! tools' summaries and figure titles go through here, never `{}` of a
+//! raw `f64` (`0.0000106 m`, `1.0006369352340698`).
+
+use alloc::{format, string::String};
+
+use crate::math::{floor, log10, powi, round};
 
 /// `x` with three significant digits, plainly (`0.00291` → `0.00291`,
 /// `0.9999999999999999` → `1.00`; whole numbers up to 99 999 in full);
@@ -16,13 +20,13 @@ pub fn sig3(x: f64) -> String {
     }
     // Rounded to three digits first: 0.99999 is 1.00, not 1.000.
     let e = exponent_of(x);
-    let x = (x / 10f64.powi(e - 2)).round() * 10f64.powi(e - 2);
+    let x = round(x / powi(10.0, e - 2)) * powi(10.0, e - 2);
     let e = exponent_of(x);
     if (-3..5).contains(&e) {
         let decimals = (2 - e).max(0) as usize;
         format!("{x:.decimals$}")
     } else {
-        let m = x / 10f64.powi(e);
+        let m = x / powi(10.0, e);
         format!("{m:.2}e{e}")
     }
 }
@@ -40,7 +44,7 @@ pub fn si(x: f64, unit: &str) -> String {
         [(-12, "p"), (-9, "n"), (-6, "µ"), (-3, "m"), (0, ""), (3, "k"), (6, "M"), (9, "G")];
     // Round to three digits first, so 999.96e-6 becomes 1.00 m, not 1000 µm.
     let e = exponent_of(x);
-    let rounded = (x / 10f64.powi(e - 2)).round() * 10f64.powi(e - 2);
+    let rounded = round(x / powi(10.0, e - 2)) * powi(10.0, e - 2);
     let e = exponent_of(rounded);
     let Some(&(p, prefix)) = PREFIXES.iter().rev().find(|(p, _)| *p <= e) else {
         return format!("{} {unit}", sig3(x));
@@ -50,7 +54,7 @@ pub fn si(x: f64, unit: &str) -> String {
     }
     // A prefix joins a symbol (`mm`, `mrad`) but stands apart from a word
     // (`169 k photons/s`).
-    let value = sig3(rounded / 10f64.powi(p));
+    let value = sig3(rounded / powi(10.0, p));
     if unit.len() > 3 && !prefix.is_empty() {
         format!("{value} {prefix} {unit}")
     } else if unit.is_empty() && prefix.is_empty() {
@@ -76,7 +80,7 @@ pub fn index(n: f64) -> String {
 /// The decimal exponent of `x`'s leading digit (`0.0029` → `-3`).
 fn exponent_of(x: f64) -> i32 {
     // A hair above, so exact powers of ten land on their own exponent.
-    (x.abs().log10() + 1e-12).floor() as i32
+    floor(log10(x.abs()) + 1e-12) as i32
 }
 
 #[cfg(test)]

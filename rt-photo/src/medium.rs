@@ -1,0 +1,80 @@
+//! Every instrument over any [`Medium`]: a grid on its octree's fast path
+//! (skipping within the tolerance each instrument cannot resolve), an
+//! exact or a smooth mesh; traced with the medium's own settings
+//! ([`Medium::params`]), not the instrument's.
+
+use rt_volume::{Medium, TraceParams};
+
+use crate::{
+    Bench, BenchError, Bos, BosError, BosImages, Film, FocusingError, FocusingImages,
+    FocusingSchlieren,
+};
+
+impl Bench {
+    /// Adds one pass to `film` through `medium` (see [`Bench::render`];
+    /// a grid as [`Bench::render_grid`]).
+    ///
+    /// # Errors
+    /// As [`Bench::render`].
+    pub fn render_medium(
+        &self,
+        medium: &Medium,
+        film: &mut Film,
+        pass: u64,
+        seed: u64,
+    ) -> Result<(), BenchError> {
+        let params: TraceParams = medium.params();
+        match medium {
+            Medium::Grid(g) => {
+                self.render_grid_with(g.field(), g.tree(), &params, film, pass, seed)
+            }
+            _ => self.render_with(&|o, d| medium.trace(o, d, None), film, pass, seed),
+        }
+    }
+
+    /// One pass through `medium` with every step integrated (no
+    /// skipping: a bench that cannot see deflections would skip them
+    /// all), as surveys need.
+    ///
+    /// # Errors
+    /// As [`Bench::render`].
+    pub fn probe_medium(&self, medium: &Medium, film: &mut Film) -> Result<(), BenchError> {
+        self.render_with(&|o, d| medium.trace(o, d, None), film, 0, 0x5eed)
+    }
+}
+
+impl Bos {
+    /// The images through `medium` (see [`Bos::render`]; a grid as
+    /// [`Bos::render_grid`]).
+    ///
+    /// # Errors
+    /// As [`Bos::render`].
+    pub fn render_medium(&self, medium: &Medium, seed: u64) -> Result<BosImages, BosError> {
+        match medium {
+            Medium::Grid(_) => {
+                let b = medium.bounds();
+                let axis = self.camera.direction.normalize();
+                let z_a = (0.5 * (b.min + b.max) - self.camera.position).dot(axis);
+                let tol = self.resolvable_deflection(z_a);
+                self.render_with(&|o, d| medium.trace(o, d, Some(tol)), seed)
+            }
+            _ => self.render_with(&|o, d| medium.trace(o, d, None), seed),
+        }
+    }
+}
+
+impl FocusingSchlieren {
+    /// The images through `medium` (see [`FocusingSchlieren::render`]; a
+    /// grid as [`FocusingSchlieren::render_grid`]).
+    ///
+    /// # Errors
+    /// As [`FocusingSchlieren::render`].
+    pub fn render_medium(
+        &self,
+        medium: &Medium,
+        seed: u64,
+    ) -> Result<FocusingImages, FocusingError> {
+        let skip = matches!(medium, Medium::Grid(_)).then(|| self.resolvable_deflection());
+        self.render_with(&|o, d| medium.trace(o, d, skip), seed)
+    }
+}

@@ -1,0 +1,136 @@
+//! Focusing schlieren set up from the data: a laboratory lens-and-grid
+//! rig, its grid pitch chosen for the flow's deflections.
+
+use rt_volume::Medium;
+
+use super::error::{finite, positive, within};
+use crate::{
+    Axis, Cutoff, FocusingImages, FocusingRig, FocusingRigOptions, FocusingSchlieren, Mode,
+    SetupError, SourceGrid, Survey, ThinLens,
+};
+
+/// What a focusing-schlieren image is to be; `None` means "choose it from
+/// the medium" (by [`FocusingRig::choose`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FocusingOptions {
+    /// The lens looks along this axis (from its + side).
+    pub axis: Axis,
+    /// Image width in pixels (the height keeps the volume's aspect).
+    pub size: u32,
+    /// The rig's lens, pixel, distances and grid pitch (metres).
+    pub rig: FocusingRigOptions,
+    /// The plane in focus: metres beyond the volume's centre, along the
+    /// view.
+    pub focus: f64,
+    /// The source grid's bright fraction of each period.
+    pub duty: f64,
+    /// The bands' direction, degrees (0: the bands run along the image's
+    /// v axis, so the system sees deflections along u).
+    pub angle: f64,
+    /// The cutoff grid's shift, in periods (0.25: a quarter band, the
+    /// linear range's middle).
+    pub offset: f64,
+    /// Bands across the source grid (`None`: as many as fill it).
+    pub bands: Option<u32>,
+    /// Aperture samples per axis (rays per pixel: its square).
+    pub samples_per_axis: u32,
+}
+
+impl Default for FocusingOptions {
+    fn default() -> Self {
+        Self {
+            axis: Axis::Z,
+            size: 512,
+            rig: FocusingRigOptions::default(),
+            focus: 0.0,
+            duty: 0.5,
+            angle: 0.0,
+            offset: 0.25,
+            bands: None,
+            samples_per_axis: 6,
+        }
+    }
+}
+
+/// A focusing-schlieren system set up for a medium (`Display`: the rig's
+/// line).
+#[derive(Clone, Debug)]
+pub struct FocusingSetup {
+    /// Lens, grids and sampling.
+    pub system: FocusingSchlieren,
+    /// The rig chosen.
+    pub rig: FocusingRig,
+}
+
+impl FocusingSetup {
+    /// Sets up `o` for `medium`; the survey runs only when the grid's
+    /// pitch is left to choose.
+    ///
+    /// # Errors
+    /// An option out of range, a bad rig, a failing survey.
+    pub fn choose(medium: &Medium, o: &FocusingOptions) -> Result<Self, SetupError> {
+        within("size", o.size, 1, 8192)?;
+        within("samples", o.samples_per_axis, 1, 64)?;
+        finite("focus", o.focus)?;
+        finite("angle", o.angle)?;
+        if let Some(p) = o.rig.grid_pitch {
+            positive("pitch", p)?;
+        }
+        let b = medium.bounds();
+        let (axis, u) = o.axis.frame();
+        let v = axis.cross(u);
+        let ext = b.max - b.min;
+        let (w, h) = o.axis.image_size(b, o.size as usize);
+        let angle = o.angle.to_radians();
+        let deflection = if o.rig.grid_pitch.is_none() {
+            let probe = crate::Bench::through(
+                b,
+                o.axis,
+                Mode::Schlieren(Cutoff::None),
+                0.0,
+                medium.params(),
+            );
+            Survey::of(medium, &probe, Survey::WIDTH)?.along(angle, 0.99)
+        } else {
+            0.0
+        };
+        let rig = FocusingRig::choose(&o.rig, ext.dot(u), w, o.focus, o.offset, deflection)?;
+        let camera = ThinLens {
+            position: 0.5 * (b.min + b.max) + rig.camera_distance * axis,
+            direction: -axis,
+            up: v,
+            focal_length: rig.focal_length,
+            f_number: rig.focal_length / rig.aperture,
+            focus_distance: rig.focus_distance,
+            pixel_pitch: rig.pixel_pitch,
+            width: w,
+            height: h,
+        };
+        let system = FocusingSchlieren {
+            camera,
+            source_distance: rig.source_distance,
+            grid: SourceGrid { pitch: rig.grid_pitch, duty: o.duty, angle, bands: o.bands },
+            cutoff_offset: o.offset,
+            aperture_samples: o.samples_per_axis,
+            params: medium.params(),
+        };
+        system.validate()?;
+        Ok(Self { system, rig })
+    }
+
+    /// The reference and flow images through `medium` (see
+    /// [`FocusingSchlieren::render_medium`]).
+    ///
+    /// # Errors
+    /// A failing trace.
+    pub fn render(&self, medium: &Medium, seed: u64) -> Result<FocusingImages, SetupError> {
+        Ok(self.system.render_medium(medium, seed)?)
+    }
+}
+
+impl core::fmt::Display for FocusingSetup {
+    /// The rig and the cutoff's shift.
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{}; cutoff offset {} pitch", self.rig, self.system.cutoff_offset)
+    }
+}
