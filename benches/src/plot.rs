@@ -9,9 +9,9 @@
 use std::{fmt, ops::Range, path::Path};
 
 use plotters::{backend::DrawingBackend, drawing::DrawingAreaErrorKind, prelude::*};
-use rt_cli::text::{FAMILY, register_font_once, superscript};
+use rt_tools::text::{FAMILY, register_font_once, superscript};
 
-use rt_cli::image::{WriteError, write_rgb8};
+use rt_tools::image::{WriteError, write_rgb8};
 
 /// The smallest and largest width or height, in pixels: below the smallest
 /// the axis texts do not fit.

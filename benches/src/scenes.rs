@@ -24,10 +24,10 @@ impl Mesh {
 }
 
 /// A noisy height field over `[-1, 1]²` with `n × n` vertices
-/// (`2 (n − 1)²` triangles): the demo's terrain ([`rt_cli::scenes::terrain`]).
+/// (`2 (n − 1)²` triangles): the demo's terrain ([`rt_tools::scenes::terrain`]).
 #[must_use]
 pub fn terrain(n: u32) -> Mesh {
-    let t = rt_cli::scenes::terrain(n);
+    let t = rt_tools::scenes::terrain(n);
     Mesh { positions: t.positions().to_vec(), indices: t.indices().to_vec() }
 }
 

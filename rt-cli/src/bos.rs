@@ -311,17 +311,3 @@ fn background(s: &str) -> Result<BackgroundChoice, String> {
         path => BackgroundChoice::Image(PathBuf::from(path)),
     })
 }
-
-impl Args {
-    /// The options `rt bos FILE ARGS…` would parse to.
-    ///
-    /// # Errors
-    /// What clap reports for bad arguments.
-    pub fn from_args<I, T>(file: &Path, args: I) -> Result<Self, clap::Error>
-    where
-        I: IntoIterator<Item = T>,
-        T: Into<std::ffi::OsString> + Clone,
-    {
-        crate::parse::subcommand("bos", file, args)
-    }
-}

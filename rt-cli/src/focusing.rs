@@ -3,7 +3,7 @@
 //! cutoff) focused on a plane in the flow, which it shows sharply while
 //! what lies before and behind it blurs away.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use rt_photo::{
     FocusingImages, FocusingOptions, FocusingRigOptions, FocusingSetup, Medium, Sensor,
@@ -206,18 +206,4 @@ pub fn prepare(medium: &Medium, a: &Args) -> anyhow::Result<FocusingSetup> {
         samples_per_axis: a.samples_per_axis,
     };
     Ok(FocusingSetup::choose(medium, &options)?)
-}
-
-impl Args {
-    /// The options `rt focusing FILE ARGS…` would parse to.
-    ///
-    /// # Errors
-    /// What clap reports for bad arguments.
-    pub fn from_args<I, T>(file: &Path, args: I) -> Result<Self, clap::Error>
-    where
-        I: IntoIterator<Item = T>,
-        T: Into<std::ffi::OsString> + Clone,
-    {
-        crate::parse::subcommand("focusing", file, args)
-    }
 }

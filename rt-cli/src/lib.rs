@@ -27,25 +27,24 @@
 //!
 //! The library half holds the commands (each a clap `Args` struct and a
 //! `run` function), so they can be driven and tested without a process.
+//! They map their options onto the libraries' set-ups (`rt_photo`'s
+//! `SchlierenSetup`, `BosSetup`, `FocusingSetup` over an
+//! `rt_volume::Medium`) and write what comes back through `rt-tools`.
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
 pub mod bos;
 pub mod demo;
 pub mod distributed;
-mod figure;
 pub mod focusing;
-pub mod image;
 pub mod info;
 pub mod optics;
-pub mod output;
 mod parse;
 mod progress;
-pub mod scenes;
 pub mod schlieren;
-pub mod text;
-pub use rt_photo::units;
 pub mod view;
-pub mod vtu;
+
+// What the commands write files with, shared with the report.
+use rt_tools::{figure, image, output};
 
 use clap::{Parser, Subcommand};
 

@@ -162,7 +162,8 @@ mod tests {
     /// `--k`'s default is written out for `--help`; it is the constant.
     #[test]
     fn the_gladstone_dale_default_is_the_constant() {
-        let a = crate::schlieren::Args::from_args(std::path::Path::new("v"), [""; 0]).unwrap();
+        let a: crate::schlieren::Args =
+            crate::parse::subcommand("schlieren", std::path::Path::new("v"), [""; 0]).unwrap();
         assert_eq!(a.samples.k, GLADSTONE_DALE_AIR);
     }
 }

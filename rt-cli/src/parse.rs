@@ -3,8 +3,8 @@
 use rt_core::glam::Vec3;
 
 /// The options `rt NAME FILE ARGS…` would parse to for a subcommand whose
-/// options are `A` (defaults included): how the demo and the bindings
-/// drive a command exactly as a user's command line would.
+/// options are `A` (defaults included): how the demo drives a command
+/// exactly as a user's command line would.
 ///
 /// # Errors
 /// What clap reports for bad arguments.

@@ -2,7 +2,7 @@
 
 use indicatif::{ProgressBar, ProgressState, ProgressStyle};
 
-use crate::units::si;
+use rt_photo::units::si;
 
 /// A bar counting `total` units of work named `unit` (e.g. "photons"),
 /// with the rate (`169 k photons/s`) and the time left.

@@ -289,21 +289,6 @@ fn figure(medium: &Medium, a: &Args, setup: &SchlierenSetup, frame: &Frame) -> F
     }
 }
 
-impl Args {
-    /// The options `rt schlieren FILE ARGS…` would parse to, defaults
-    /// included.
-    ///
-    /// # Errors
-    /// What clap reports for bad arguments.
-    pub fn from_args<I, T>(file: &std::path::Path, args: I) -> Result<Self, clap::Error>
-    where
-        I: IntoIterator<Item = T>,
-        T: Into<std::ffi::OsString> + Clone,
-    {
-        crate::parse::subcommand("schlieren", file, args)
-    }
-}
-
 /// One line: what was written, how many photons in how long, the optics.
 pub(crate) fn summary(written: &[PathBuf], film: &Film, seconds: f64, chosen: &str) -> String {
     let files: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();

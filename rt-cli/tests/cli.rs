@@ -28,7 +28,7 @@ fn scratch(name: &str) -> PathBuf {
 
 /// The built-in blast wave (a detached NRRD header beside its payload).
 fn blast_wave() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("data/blast_sedov_64.nhdr")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../rt-tools/data/blast_sedov_64.nhdr")
 }
 
 /// Asserts a failed run with a one-line `rt: error:` message holding each

@@ -16,7 +16,7 @@ mod volume;
 
 use pyo3::{exceptions::PyValueError, prelude::*};
 
-/// A `ValueError` carrying `e`'s message (with its causes, for `anyhow`).
+/// A `ValueError` carrying `e`'s message.
 pub(crate) fn value_error(e: impl core::fmt::Display) -> PyErr {
     PyValueError::new_err(format!("{e:#}"))
 }

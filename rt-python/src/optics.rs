@@ -1,53 +1,57 @@
-//! The optical bench: schlieren (every cutoff), shadowgraph,
-//! interferometry and colour schlieren of a volume, set up as `rt
-//! schlieren` sets it up (the same defaults, the same automatic exposure,
-//! the same photons), so both give the same image for the same options;
-//! background-oriented and focusing schlieren set up by `rt bos`'s and `rt
-//! focusing`'s own option parsers, for the same reason.
+//! The instruments: schlieren (every cutoff), shadowgraph,
+//! interferometry and colour schlieren, background-oriented and focusing
+//! schlieren of a volume, set up by the library's own set-ups
+//! (`rt_photo::SchlierenSetup`, `BosSetup`, `FocusingSetup`) as `rt
+//! schlieren`, `rt bos` and `rt focusing` set them up: the same defaults,
+//! the same automatic choices, the same image for the same options. The
+//! options are checked once, there.
 
-use std::path::PathBuf;
-
-use clap::ValueEnum;
 use numpy::{
     IntoPyArray, PyArray2, PyArray3, PyReadonlyArray2,
     ndarray::{Array2, Array3},
 };
 use pyo3::prelude::*;
-use rt_cli::{
-    optics::{Axis, Interpolation, MeshOptions, Quantity, Samples, Source},
-    schlieren::{Args, CutoffKind, Estimator, prepare},
+use rt_photo::{
+    Airy, Axis, BackgroundChoice, BosOptions, BosRigOptions, BosSetup, CutoffKind, FocusingOptions,
+    FocusingRigOptions, FocusingSetup, Reconstruction, SchlierenOptions, SchlierenSetup, Sensor,
 };
-use rt_photo::{Airy, Bench, ImageBackground, Mode, Reconstruction, Sensor};
-use rt_volume::GLADSTONE_DALE_AIR;
 
 use crate::{value_error, volume::PyVolume};
 
-/// Longest image side, as `rt schlieren --size` allows.
-const MAX_EDGE: u32 = 16384;
+/// The axis named `s`.
+fn axis(s: &str) -> PyResult<Axis> {
+    match s {
+        "x" => Ok(Axis::X),
+        "y" => Ok(Axis::Y),
+        "z" => Ok(Axis::Z),
+        _ => Err(value_error(format!("axis: unknown `{s}` (known: x, y, z)"))),
+    }
+}
 
-/// The value of enum `E` named `s` (as the command line spells it).
-fn parse<E: ValueEnum>(what: &str, s: &str) -> PyResult<E> {
-    E::from_str(s, false).map_err(|_| {
-        let known: Vec<String> = E::value_variants()
-            .iter()
-            .filter_map(|v| v.to_possible_value().map(|p| p.get_name().to_string()))
-            .collect();
-        value_error(format!("{what}: unknown `{s}` (known: {})", known.join(", ")))
+/// The cutoff named `s`, as `rt schlieren --cutoff` spells it.
+fn cutoff(s: &str) -> PyResult<CutoffKind> {
+    Ok(match s {
+        "knife" => CutoffKind::Knife,
+        "graded" => CutoffKind::Graded,
+        "pinhole" => CutoffKind::Pinhole,
+        "dark-field" => CutoffKind::DarkField,
+        "color" => CutoffKind::Color,
+        "none" => CutoffKind::None,
+        "interferometry" => CutoffKind::Interferometry,
+        _ => {
+            return Err(value_error(format!(
+                "cutoff: unknown `{s}` (known: knife, graded, pinhole, dark-field, color, none, interferometry)"
+            )));
+        }
     })
 }
 
-/// A `ValueError` carrying the first line of what clap says about bad
-/// command-line arguments.
-fn command_line_error(e: clap::Error) -> PyErr {
-    value_error(e.to_string().lines().next().unwrap_or_default().trim_start_matches("error: "))
-}
-
-/// `Err` unless `v` is finite and `> 0`.
-fn positive(name: &str, v: f64) -> PyResult<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(value_error(format!("{name} must be finite and > 0 (got {v})")))
+/// The estimator named `s`.
+fn estimator(s: &str) -> PyResult<Reconstruction> {
+    match s {
+        "sheet" => Ok(Reconstruction::Sheet),
+        "photons" => Ok(Reconstruction::Photons),
+        _ => Err(value_error(format!("estimator: unknown `{s}` (known: sheet, photons)"))),
     }
 }
 
@@ -56,24 +60,25 @@ fn positive(name: &str, v: f64) -> PyResult<f64> {
 /// landed), the mean interferometric phase [h, w] in radians (NaN where
 /// no photon landed; 0 outside interferometry), the image of an
 /// undisturbed beam through the optics (RGB), a line saying which optics
-/// were chosen)`.
+/// were chosen, a warning about the set-up (aliasing fringes) or None)`.
 type Optics<'py> = (
     Bound<'py, PyArray3<f64>>,
     Bound<'py, PyArray3<f32>>,
     Bound<'py, PyArray2<f64>>,
     [f32; 3],
     String,
+    Option<String>,
 );
 
 /// Renders `volume` on the bench the arguments describe.
 #[pyfunction]
 #[pyo3(name = "_optics")]
-#[pyo3(signature = (volume, cutoff, angle, f, h, radius, half_range, wavelength, fringe_spacing, film_distance, axis, size, photons, seed, estimator))]
+#[pyo3(signature = (volume, cutoff_name, angle, f, h, radius, half_range, wavelength, fringe_spacing, film_distance, axis_name, size, photons, seed, estimator_name))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn optics<'py>(
     py: Python<'py>,
     volume: &PyVolume,
-    cutoff: &str,
+    cutoff_name: &str,
     angle: f64,
     f: f64,
     h: Option<f64>,
@@ -82,64 +87,33 @@ pub(crate) fn optics<'py>(
     wavelength: f64,
     fringe_spacing: Option<f64>,
     film_distance: Option<f64>,
-    axis: &str,
+    axis_name: &str,
     size: u32,
     photons: u32,
     seed: u64,
-    estimator: &str,
+    estimator_name: &str,
 ) -> PyResult<Optics<'py>> {
-    if !angle.is_finite() {
-        return Err(value_error(format!("angle must be finite (got {angle})")));
-    }
-    if let Some(d) = film_distance.filter(|d| !d.is_finite()) {
-        return Err(value_error(format!("film_distance must be finite (got {d})")));
-    }
-    if !(1..=MAX_EDGE).contains(&size) {
-        return Err(value_error(format!("size must be 1 to {MAX_EDGE} pixels (got {size})")));
-    }
-    if !(1..=65536).contains(&photons) {
-        return Err(value_error(format!("photons must be 1 to 65536 per pixel (got {photons})")));
-    }
-    let args = Args {
-        file: PathBuf::new(),
-        samples: Samples { quantity: Quantity::Density, k: GLADSTONE_DALE_AIR },
-        allow_nonphysical: false,
-        cutoff: parse::<CutoffKind>("cutoff", cutoff)?,
+    let options = SchlierenOptions {
+        cutoff: cutoff(cutoff_name)?,
         angle,
-        f: positive("f", f)?,
-        h: h.map(|v| positive("h", v)).transpose()?,
-        radius: radius.map(|v| positive("radius", v)).transpose()?,
-        half_range: half_range.map(|v| positive("half_range", v)).transpose()?,
-        lambda: positive("wavelength", wavelength)?,
-        fringes: fringe_spacing.map(|v| positive("fringe_spacing", v)).transpose()?,
+        f,
+        h,
+        radius,
+        half_range,
+        wavelength,
+        fringes: fringe_spacing,
         film_distance,
-        axis: parse::<Axis>("axis", axis)?,
+        axis: axis(axis_name)?,
         size,
         photons,
-        estimator: parse::<Estimator>("estimator", estimator)?,
-        interp: Interpolation::Linear,
-        mesh: MeshOptions::default(),
-        seed,
-        out: PathBuf::new(),
-        figure: false,
-        no_figure: true,
-        raw16: false,
+        reconstruction: estimator(estimator_name)?,
     };
     let v = &volume.inner;
-    let (film, background, chosen) = py
-        .detach(|| -> anyhow::Result<_> {
-            let (bench, chosen) = prepare(v, &args)?;
-            let bench = match args.estimator {
-                Estimator::Sheet => bench,
-                Estimator::Photons => Bench { reconstruction: Reconstruction::Photons, ..bench },
-            };
-            let background = match &bench.mode {
-                Mode::Schlieren(c) => c.transmit(0.0, 0.0),
-                // Infinite fringe: the undisturbed beam is bright.
-                Mode::Interferometry { .. } => [1.0; 3],
-            };
-            let (film, _) = v.render(&bench, size as usize, photons, seed)?;
-            Ok((film, background, chosen))
+    let (film, setup) = py
+        .detach(|| -> Result<_, rt_photo::SetupError> {
+            let setup = SchlierenSetup::choose(v, &options)?;
+            let film = setup.render(v, seed, &mut |_, _| {})?;
+            Ok((film, setup))
         })
         .map_err(value_error)?;
     let (w, h) = (film.width(), film.height());
@@ -157,8 +131,9 @@ pub(crate) fn optics<'py>(
         image.into_pyarray(py),
         deflection.into_pyarray(py),
         phase.into_pyarray(py),
-        background,
-        chosen,
+        setup.background(),
+        setup.to_string(),
+        setup.warning,
     ))
 }
 
@@ -194,40 +169,74 @@ pub(crate) fn record<'py>(
 type BosOut<'py> =
     (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>, String);
 
-/// Background-oriented schlieren of `volume`, set up by `rt bos`'s own
-/// options (`args`: its command-line arguments after the file); `image`
-/// (grey, row 0 at the top) replaces the background, each of its pixels
-/// `image_pixel` sensor pixels as imaged (default: it spans the width).
+/// Background-oriented schlieren of `volume` ([`BosSetup`]); the
+/// background is `"random"`, `"grid"`, the path of a PNG image, or
+/// `image` (grey, row 0 at the top), each of its pixels `image_pixel`
+/// sensor pixels as imaged (default: it spans the width).
 #[pyfunction]
 #[pyo3(name = "_bos")]
-#[pyo3(signature = (volume, args, image=None, image_pixel=None))]
+#[pyo3(signature = (volume, axis_name, size, focal_length, f_number, pixel, distance, background_distance, dot, spacing, samples, seed, background, image=None, image_pixel=None))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn bos<'py>(
     py: Python<'py>,
     volume: &PyVolume,
-    args: Vec<String>,
+    axis_name: &str,
+    size: u32,
+    focal_length: Option<f64>,
+    f_number: f64,
+    pixel: Option<f64>,
+    distance: Option<f64>,
+    background_distance: Option<f64>,
+    dot: f64,
+    spacing: f64,
+    samples: u32,
+    seed: u64,
+    background: &str,
     image: Option<PyReadonlyArray2<'py, f64>>,
     image_pixel: Option<f64>,
 ) -> PyResult<BosOut<'py>> {
-    let a = rt_cli::bos::Args::from_args(std::path::Path::new("volume"), args)
-        .map_err(command_line_error)?;
+    let background = match (image, background) {
+        (Some(i), _) => {
+            let view = i.as_array();
+            let (h, w) = view.dim();
+            let samples = view.iter().copied().collect();
+            BackgroundChoice::Image { width: w, height: h, samples, pixel: image_pixel }
+        }
+        (None, "random") => BackgroundChoice::Random,
+        (None, "grid") => BackgroundChoice::Grid,
+        (None, path) => BackgroundChoice::read_png(std::path::Path::new(path), image_pixel)
+            .map_err(|e| match e {
+                rt_photo::PngError::Io { .. } => {
+                    pyo3::exceptions::PyOSError::new_err(e.to_string())
+                }
+                rt_photo::PngError::Malformed { .. } => value_error(e),
+            })?,
+    };
+    let options = BosOptions {
+        axis: axis(axis_name)?,
+        size,
+        rig: BosRigOptions {
+            focal_length,
+            pixel_pitch: pixel,
+            camera_distance: distance,
+            background_distance,
+        },
+        f_number,
+        background,
+        dot,
+        spacing,
+        samples_per_axis: samples,
+        seed,
+    };
     let v = &volume.inner;
-    let image = image.map(|i| {
-        let view = i.as_array();
-        let (h, w) = view.dim();
-        (w, h, view.iter().copied().collect::<Vec<f64>>())
-    });
-    let (bos, rig, images) = py
-        .detach(|| -> anyhow::Result<_> {
-            let (mut bos, rig) = rt_cli::bos::prepare(v, &a)?;
-            if let Some((w, h, samples)) = image {
-                let px = image_pixel.unwrap_or(bos.camera.width as f64 / w as f64);
-                bos.background =
-                    ImageBackground::for_camera(&bos.camera, w, h, samples, px)?.into();
-            }
-            let images = v.bos(&bos, a.seed)?;
-            Ok((bos, rig, images))
+    let (setup, images) = py
+        .detach(|| -> Result<_, rt_photo::SetupError> {
+            let setup = BosSetup::choose(v, &options)?;
+            let images = setup.render(v, seed)?;
+            Ok((setup, images))
         })
         .map_err(value_error)?;
+    let (bos, rig) = (&setup.bos, &setup.rig);
     let (w, h) = (images.width, images.height);
     let c = bos.camera;
     let said = format!(
@@ -249,28 +258,57 @@ pub(crate) fn bos<'py>(
 type FocusingOut<'py> =
     (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, String);
 
-/// Focusing schlieren of `volume`, set up by `rt focusing`'s own options
-/// (`args`: its command-line arguments after the file), so every default
-/// and every automatic choice (the grid's pitch from a survey of the flow)
-/// is the command line's.
+/// Focusing schlieren of `volume` ([`FocusingSetup`]).
 #[pyfunction]
 #[pyo3(name = "_focusing")]
-#[pyo3(signature = (volume, args))]
+#[pyo3(signature = (volume, axis_name, size, focal_length, aperture, pixel, distance, focus, source_distance, pitch, duty, angle, offset, bands, samples, seed))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn focusing<'py>(
     py: Python<'py>,
     volume: &PyVolume,
-    args: Vec<String>,
+    axis_name: &str,
+    size: u32,
+    focal_length: Option<f64>,
+    aperture: Option<f64>,
+    pixel: Option<f64>,
+    distance: Option<f64>,
+    focus: f64,
+    source_distance: Option<f64>,
+    pitch: Option<f64>,
+    duty: f64,
+    angle: f64,
+    offset: f64,
+    bands: Option<u32>,
+    samples: u32,
+    seed: u64,
 ) -> PyResult<FocusingOut<'py>> {
-    let a = rt_cli::focusing::Args::from_args(std::path::Path::new("volume"), args)
-        .map_err(command_line_error)?;
+    let options = FocusingOptions {
+        axis: axis(axis_name)?,
+        size,
+        rig: FocusingRigOptions {
+            focal_length,
+            aperture,
+            pixel_pitch: pixel,
+            camera_distance: distance,
+            source_distance,
+            grid_pitch: pitch,
+        },
+        focus,
+        duty,
+        angle,
+        offset,
+        bands,
+        samples_per_axis: samples,
+    };
     let v = &volume.inner;
-    let (fs, images) = py
-        .detach(|| -> anyhow::Result<_> {
-            let (fs, _) = rt_cli::focusing::prepare(v, &a)?;
-            let images = v.focusing(&fs, a.seed)?;
-            Ok((fs, images))
+    let (setup, images) = py
+        .detach(|| -> Result<_, rt_photo::SetupError> {
+            let setup = FocusingSetup::choose(v, &options)?;
+            let images = setup.render(v, seed)?;
+            Ok((setup, images))
         })
         .map_err(value_error)?;
+    let fs = &setup.system;
     let (w, h) = (images.width, images.height);
     let c = fs.camera;
     let z_f = c.focus_distance;
@@ -286,7 +324,7 @@ pub(crate) fn focusing<'py>(
         fs.grid.pitch,
         c.aperture() * (fs.source_distance - z_f) / z_f / fs.grid.pitch,
         fs.grid.duty,
-        a.angle,
+        angle,
         fs.cutoff_offset,
         w,
         h,

@@ -6,9 +6,8 @@ use std::path::PathBuf;
 use numpy::PyReadonlyArray3;
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::{exceptions::PyOSError, prelude::*};
-use rt_cli::optics::{AnyVolume, Interpolation, MeshTrace, MeshVolume, Quantity, Volume};
 use rt_volume::{
-    Cell, Grid,
+    Cell, Grid, GridField, Interp, Medium, MediumError, MeshTrace, Samples,
     glam::DVec3,
     io::{ReadErrorKind, UnstructuredData, read_grid, read_unstructured},
 };
@@ -19,43 +18,51 @@ use crate::value_error;
 /// octree) or an unstructured mesh.
 #[pyclass(name = "_Volume", module = "rtvis._rtvis", frozen)]
 pub(crate) struct PyVolume {
-    pub(crate) inner: AnyVolume,
+    pub(crate) inner: Medium,
 }
 
 impl PyVolume {
-    /// The grid, or a `ValueError` for a mesh.
-    fn grid(&self) -> PyResult<&Volume> {
+    /// The gridded field, or a `ValueError` for a mesh.
+    fn grid(&self) -> PyResult<&GridField> {
         match &self.inner {
-            AnyVolume::Grid(v) => Ok(v.as_ref()),
-            AnyVolume::Mesh(_) => Err(value_error("an unstructured mesh has no grid")),
+            Medium::Grid(g) => Ok(g.field()),
+            _ => Err(value_error("an unstructured mesh has no grid")),
         }
     }
 }
 
-/// `quantity` and `interpolation` by name.
-fn options(quantity: &str, interpolation: &str) -> PyResult<(Quantity, Interpolation)> {
-    let q = match quantity {
-        "density" => Quantity::Density,
-        "index" => Quantity::Index,
-        other => {
-            return Err(value_error(format!(
-                "quantity: unknown `{other}` (known: density, index)"
-            )));
-        }
-    };
-    let i = match interpolation {
-        "linear" => Interpolation::Linear,
-        "cubic" => Interpolation::Cubic,
-        other => {
-            return Err(value_error(format!(
-                "interpolation: unknown `{other}` (known: linear, cubic)"
-            )));
-        }
-    };
-    Ok((q, i))
+/// What `quantity` (with constant `k`) names.
+fn samples(quantity: &str, k: f64) -> PyResult<Samples> {
+    match quantity {
+        "density" => Ok(Samples::Density { gladstone_dale: k }),
+        "index" => Ok(Samples::Index),
+        other => Err(value_error(format!("quantity: unknown `{other}` (known: density, index)"))),
+    }
 }
 
-/// The volume of `grid`, built with the GIL released.
+/// The interpolant `interpolation` names.
+fn interp(interpolation: &str) -> PyResult<Interp> {
+    match interpolation {
+        "linear" => Ok(Interp::Trilinear),
+        "cubic" => Ok(Interp::CatmullRom),
+        other => {
+            Err(value_error(format!("interpolation: unknown `{other}` (known: linear, cubic)")))
+        }
+    }
+}
+
+/// A `ValueError` for samples that make no medium, with the keywords that
+/// fix a non-physical one.
+fn medium_error(e: MediumError) -> PyErr {
+    match e {
+        MediumError::NonPhysical { .. } => {
+            value_error(format!("{e}; check quantity=, or pass allow_nonphysical=True"))
+        }
+        e => value_error(e),
+    }
+}
+
+/// The medium of `grid`'s samples, built with the GIL released.
 fn build(
     py: Python<'_>,
     grid: Grid,
@@ -64,9 +71,10 @@ fn build(
     interpolation: &str,
     allow_nonphysical: bool,
 ) -> PyResult<PyVolume> {
-    let (q, i) = options(quantity, interpolation)?;
-    let inner = py.detach(|| Volume::new(grid, q, k, allow_nonphysical, i)).map_err(value_error)?;
-    Ok(PyVolume { inner: AnyVolume::Grid(Box::new(inner)) })
+    let (s, i) = (samples(quantity, k)?, interp(interpolation)?);
+    let inner =
+        py.detach(|| Medium::from_grid(grid, s, allow_nonphysical, i)).map_err(medium_error)?;
+    Ok(PyVolume { inner })
 }
 
 #[pymethods]
@@ -96,39 +104,38 @@ impl PyVolume {
     /// Samples per axis, `(nz, ny, nx)` as the array's shape.
     #[getter]
     fn shape(&self) -> PyResult<(usize, usize, usize)> {
-        let [nx, ny, nz] = self.grid()?.field.grid().dims();
+        let [nx, ny, nz] = self.grid()?.grid().dims();
         Ok((nz, ny, nx))
     }
 
     /// Sample spacing `(dx, dy, dz)`.
     #[getter]
     fn spacing(&self) -> PyResult<[f64; 3]> {
-        Ok(self.grid()?.field.grid().spacing().to_array())
+        Ok(self.grid()?.grid().spacing().to_array())
     }
 
     /// Centre of sample `[0, 0, 0]`, `(x, y, z)`.
     #[getter]
     fn origin(&self) -> PyResult<[f64; 3]> {
-        Ok(self.grid()?.field.grid().origin().to_array())
+        Ok(self.grid()?.grid().origin().to_array())
     }
 
     /// `((xmin, ymin, zmin), (xmax, ymax, zmax))`: the box the samples
     /// cover.
     #[getter]
     fn bounds(&self) -> ([f64; 3], [f64; 3]) {
-        let b = rt_cli::optics::Source::bounds(&self.inner);
+        let b = self.inner.bounds();
         (b.min.to_array(), b.max.to_array())
     }
 
     /// For a mesh: `(points, cells, tetrahedra, boundary faces)`.
     #[getter]
     fn mesh_counts(&self) -> PyResult<(usize, usize, usize, usize)> {
-        match &self.inner {
-            AnyVolume::Mesh(m) => {
-                let f = m.mesh();
+        match self.inner.mesh() {
+            Some(f) => {
                 Ok((f.points().len(), f.cell_count(), f.tetrahedra().len(), f.boundary_faces()))
             }
-            AnyVolume::Grid(_) => Err(value_error("a grid is not an unstructured mesh")),
+            None => Err(value_error("a grid is not an unstructured mesh")),
         }
     }
 
@@ -200,7 +207,7 @@ impl PyVolume {
     /// The refractive index samples, `[z, y, x]`.
     fn index<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray3<f32>>> {
         let (nz, ny, nx) = self.shape()?;
-        let data = self.grid()?.field.grid().data().to_vec();
+        let data = self.grid()?.grid().data().to_vec();
         let a = numpy::ndarray::Array3::from_shape_vec((nz, ny, nx), data).map_err(value_error)?;
         Ok(numpy::IntoPyArray::into_pyarray(a, py))
     }
@@ -218,7 +225,8 @@ pub(crate) fn read_volume(
     interpolation: &str,
     allow_nonphysical: bool,
 ) -> PyResult<PyVolume> {
-    options(quantity, interpolation)?;
+    samples(quantity, k)?;
+    interp(interpolation)?;
     let grid = py.detach(|| read_grid(&path)).map_err(|e| {
         // The error names the file.
         let msg = e.to_string();
@@ -239,7 +247,7 @@ fn build_mesh(
     trace: &str,
     allow_nonphysical: bool,
 ) -> PyResult<PyVolume> {
-    let (q, _) = options(quantity, "linear")?;
+    let s = samples(quantity, k)?;
     let how = match trace {
         "exact" => MeshTrace::Exact,
         "smooth" => MeshTrace::Smooth,
@@ -254,9 +262,13 @@ fn build_mesh(
             data.points.len()
         )));
     }
-    let inner =
-        py.detach(|| MeshVolume::new(data, q, k, allow_nonphysical, how)).map_err(value_error)?;
-    Ok(PyVolume { inner: AnyVolume::Mesh(Box::new(inner)) })
+    let inner = py
+        .detach(|| {
+            let (points, values) = (data.points, data.values);
+            Medium::from_mesh(points, &data.cells, values, s, allow_nonphysical, &data.array, how)
+        })
+        .map_err(medium_error)?;
+    Ok(PyVolume { inner })
 }
 
 /// Reads an unstructured mesh file (VTK `.vtu`, legacy `.vtk`).

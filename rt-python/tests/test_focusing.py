@@ -137,16 +137,22 @@ def test_bad_input(gaussian):
         rtvis.focusing(vol, size="64")
     with pytest.raises(TypeError, match="angle: expected a number"):
         rtvis.focusing(vol, angle=None, **kw)
-    # What only the set-up can tell: raised by the command line's checks.
+    # What only the set-up can tell: raised by the library's set-up.
     with pytest.raises(ValueError, match="farther from the lens"):
         rtvis.focusing(vol, focus=0.07, **kw)
     with pytest.raises(ValueError, match="must lie beyond the focus plane"):
         rtvis.focusing(vol, source_distance=0.01, **kw)
-    # The native half refuses what the Python half would have caught.
+    # The native half refuses on its own what the Python half would have
+    # caught: the library's set-up checks every option, once.
     native = rtvis._rtvis._focusing
-    with pytest.raises(ValueError, match="--bogus"):
-        native(vol._v, ["--bogus"])
+    args = dict(axis_name="z", size=8, focal_length=None, aperture=None, pixel=None,
+                distance=None, focus=0.0, source_distance=None, pitch=None, duty=0.5,
+                angle=0.0, offset=0.25, bands=None, samples=1, seed=1)
     with pytest.raises(ValueError, match=r"duty cycle must be in \(0, 1\)"):
-        native(vol._v, ["--size", "8", "--duty", "1.5"])
-    with pytest.raises(ValueError, match="invalid value"):
-        native(vol._v, ["--aperture", "-1"])
+        native(vol._v, **{**args, "duty": 1.5})
+    with pytest.raises(ValueError, match=r"aperture must be finite and > 0 \(got -1\)"):
+        native(vol._v, **{**args, "aperture": -1.0})
+    with pytest.raises(ValueError, match="size must be 1 to 8192"):
+        native(vol._v, **{**args, "size": 0})
+    with pytest.raises(ValueError, match="axis: unknown `w`"):
+        native(vol._v, **{**args, "axis_name": "w"})

@@ -10,7 +10,7 @@ use rt_volume::io::{ReadError, ReadErrorKind, parse_nrrd, read_grid};
 /// The repository's copy of the project's real CFD data (the main job
 /// embeds it): raw payload, JSON sidecar and a detached NRRD header.
 fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../rt-cli/data").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../rt-tools/data").join(name)
 }
 
 /// The blast wave through every form: detached NRRD header, the same header

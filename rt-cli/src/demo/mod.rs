@@ -15,7 +15,7 @@
 //!   white (as `rt view` draws by default).
 //! - `terrain.ply`: the terrain mesh with its `height` scalar, to try the
 //!   `rt view` on (`--scalar height`).
-//! - From the built-in blast wave (`rt-cli/data/`, a real PyClaw Euler
+//! - From the built-in blast wave (`rt-tools/data/`, a real PyClaw Euler
 //!   solution, density → index by Gladstone–Dale), photons traced through
 //!   the volume along z: `schlieren-knife.png` (vertical knife edge,
 //!   background mid-grey), `shadowgraph.png` (film 2 m behind, background
@@ -35,8 +35,6 @@
 //!   rendered from it as `rt schlieren blast.vtu --mesh smooth` does.
 mod optics;
 
-pub use optics::{blast_wave, blast_wave_with, write_blast_wave};
-
 use std::{path::PathBuf, time::Instant};
 
 use anyhow::Context;
@@ -45,7 +43,7 @@ use rt_surface::{
     Glyphs, Light, Material, Mesh, Paint, Renderer, Settings, SurfaceScene, Tube, io::write_ply,
 };
 
-use crate::{
+use rt_tools::{
     image::{over_background, write_png},
     output::{Outputs, make_folder},
     scenes,

@@ -16,20 +16,41 @@ const MAX_PIXELS: u64 = 1 << 24;
 
 /// Why a background image could not be read; each names the file.
 #[derive(Debug)]
-pub struct PngError {
-    /// The file.
-    pub path: std::path::PathBuf,
-    /// What went wrong.
-    pub what: String,
+pub enum PngError {
+    /// The file could not be opened or read.
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// The file is not a PNG we read: malformed, truncated, over 4096²
+    /// pixels.
+    Malformed {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong with it.
+        what: String,
+    },
 }
 
 impl fmt::Display for PngError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.path.display(), self.what)
+        match self {
+            Self::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            Self::Malformed { path, what } => write!(f, "{}: {what}", path.display()),
+        }
     }
 }
 
-impl core::error::Error for PngError {}
+impl core::error::Error for PngError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            Self::Io { source, .. } => Some(source),
+            Self::Malformed { .. } => None,
+        }
+    }
+}
 
 impl BackgroundChoice {
     /// Reads a PNG (grey or colour, 1–16 bits, palette included; alpha
@@ -42,8 +63,8 @@ impl BackgroundChoice {
     /// # Errors
     /// An unreadable or malformed file, or one over 4096² pixels.
     pub fn read_png(path: &Path, pixel: Option<f64>) -> Result<Self, PngError> {
-        let err = |what: String| PngError { path: path.into(), what };
-        let file = File::open(path).map_err(|e| err(e.to_string()))?;
+        let err = |what: String| PngError::Malformed { path: path.into(), what };
+        let file = File::open(path).map_err(|source| PngError::Io { path: path.into(), source })?;
         let mut decoder = png::Decoder::new(BufReader::new(file));
         decoder.set_transformations(png::Transformations::EXPAND);
         let mut reader = decoder.read_info().map_err(|e| err(e.to_string()))?;

@@ -97,6 +97,15 @@ impl BosSetup {
         positive("f_number", o.f_number)?;
         positive("dot", o.dot)?;
         positive("spacing", o.spacing)?;
+        let r = &o.rig;
+        for (name, v) in [
+            ("focal_length", r.focal_length),
+            ("pixel", r.pixel_pitch),
+            ("distance", r.camera_distance),
+            ("background_distance", r.background_distance),
+        ] {
+            v.map(|v| positive(name, v)).transpose()?;
+        }
         let b = medium.bounds();
         let (axis, u) = o.axis.frame();
         let v = axis.cross(u);

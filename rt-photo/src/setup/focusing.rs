@@ -73,8 +73,16 @@ impl FocusingSetup {
         within("samples", o.samples_per_axis, 1, 64)?;
         finite("focus", o.focus)?;
         finite("angle", o.angle)?;
-        if let Some(p) = o.rig.grid_pitch {
-            positive("pitch", p)?;
+        let r = &o.rig;
+        for (name, v) in [
+            ("focal_length", r.focal_length),
+            ("aperture", r.aperture),
+            ("pixel", r.pixel_pitch),
+            ("distance", r.camera_distance),
+            ("source_distance", r.source_distance),
+            ("pitch", r.grid_pitch),
+        ] {
+            v.map(|v| positive(name, v)).transpose()?;
         }
         let b = medium.bounds();
         let (axis, u) = o.axis.frame();

@@ -374,7 +374,7 @@ def _bench(volume, cutoff, *, angle=0.0, f=1.0, h=None, radius=None, half_range=
            photons=16, seed=1, estimator="sheet"):
     if not isinstance(volume, (Volume, Mesh)):
         raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
-    return _rtvis._optics(
+    *out, warning = _rtvis._optics(
         volume._v,
         cutoff,
         _number("angle", angle),
@@ -391,6 +391,11 @@ def _bench(volume, cutoff, *, angle=0.0, f=1.0, h=None, radius=None, half_range=
         _integer("seed", seed, 0, 2**64 - 1),
         _choice("estimator", estimator, ("sheet", "photons")),
     )
+    if warning is not None:
+        import warnings
+
+        warnings.warn(warning, stacklevel=3)
+    return tuple(out)
 
 
 def _dtype(dtype):
@@ -615,36 +620,34 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
     """
     if not isinstance(volume, (Volume, Mesh)):
         raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
-    args = ["--axis", _choice("axis", axis, ("x", "y", "z")),
-            "--size", str(_integer("size", size, 1, 8192)),
-            "--f-number", repr(_number("f_number", f_number, positive=True)),
-            "--dot", repr(_number("dot", dot, positive=True)),
-            "--spacing", repr(_number("spacing", spacing, positive=True)),
-            "--samples-per-axis", str(_integer("samples", samples, 1, 64)),
-            "--seed", str(_integer("seed", seed, 0, 2**64 - 1))]
-    if focal_length is not None:
-        args += ["--focal-length", repr(_number("focal_length", focal_length, positive=True))]
-    if pixel is not None:
-        args += ["--pixel", repr(_number("pixel", pixel, positive=True))]
-    if distance is not None:
-        args += ["--distance", repr(_number("distance", distance, positive=True))]
-    if background_distance is not None:
-        args += ["--background-distance", repr(_number("background_distance", background_distance, positive=True))]
     image = None
+    name = "random"
     if isinstance(background, (str, os.PathLike)):
         name = os.fspath(background)
         if name == "":
             raise ValueError("background: \"random\", \"grid\", the path of a PNG image or a 2-D array")
-        args += ["--background", name]
     else:
         image = _array("background", background, 2, np.float64)
         if (image < 0).any():
             where = tuple(int(i) for i in np.argwhere(image < 0)[0])
             raise ValueError(f"background: value at {where} is negative ({image[where]})")
-    pixel_px = _number("background_pixel", background_pixel, positive=True, optional=True)
-    if pixel_px is not None and image is None:
-        args += ["--background-pixel", repr(pixel_px)]
-    return _rtvis._bos(volume._v, args, image, pixel_px)
+    return _rtvis._bos(
+        volume._v,
+        _choice("axis", axis, ("x", "y", "z")),
+        _integer("size", size, 1, 8192),
+        _number("focal_length", focal_length, positive=True, optional=True),
+        _number("f_number", f_number, positive=True),
+        _number("pixel", pixel, positive=True, optional=True),
+        _number("distance", distance, positive=True, optional=True),
+        _number("background_distance", background_distance, positive=True, optional=True),
+        _number("dot", dot, positive=True),
+        _number("spacing", spacing, positive=True),
+        _integer("samples", samples, 1, 64),
+        _integer("seed", seed, 0, 2**64 - 1),
+        name,
+        image,
+        _number("background_pixel", background_pixel, positive=True, optional=True),
+    )
 
 
 def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_length: Optional[float] = None,
@@ -723,22 +726,24 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
     offset = _number("offset", offset)
     if not 0.0 <= offset < 1.0:
         raise ValueError(f"offset must be in [0, 1) pitches (got {offset})")
-    args = ["--axis", _choice("axis", axis, ("x", "y", "z")),
-            "--size", str(_integer("size", size, 1, 8192)),
-            "--focus", repr(_number("focus", focus)),
-            "--duty", repr(duty),
-            "--angle", repr(_number("angle", angle)),
-            "--offset", repr(offset),
-            "--samples-per-axis", str(_integer("samples", samples, 1, 64)),
-            "--seed", str(_integer("seed", seed, 0, 2**64 - 1))]
-    for name, value in (("focal_length", focal_length), ("aperture", aperture), ("pixel", pixel),
-                        ("distance", distance),
-                        ("source_distance", source_distance), ("pitch", pitch)):
-        if value is not None:
-            args += ["--" + name.replace("_", "-"), repr(_number(name, value, positive=True))]
-    if bands is not None:
-        args += ["--bands", str(_integer("bands", bands, 1, 2**32 - 1))]
-    return _rtvis._focusing(volume._v, args)
+    return _rtvis._focusing(
+        volume._v,
+        _choice("axis", axis, ("x", "y", "z")),
+        _integer("size", size, 1, 8192),
+        _number("focal_length", focal_length, positive=True, optional=True),
+        _number("aperture", aperture, positive=True, optional=True),
+        _number("pixel", pixel, positive=True, optional=True),
+        _number("distance", distance, positive=True, optional=True),
+        _number("focus", focus),
+        _number("source_distance", source_distance, positive=True, optional=True),
+        _number("pitch", pitch, positive=True, optional=True),
+        duty,
+        _number("angle", angle),
+        offset,
+        None if bands is None else _integer("bands", bands, 1, 2**32 - 1),
+        _integer("samples", samples, 1, 64),
+        _integer("seed", seed, 0, 2**64 - 1),
+    )
 
 
 def record(image, exposure: float = 10_000.0, full_well: float = 20_000.0, bits: int = 16,

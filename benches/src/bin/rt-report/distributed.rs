@@ -16,9 +16,9 @@
 use std::{fmt::Write as _, path::Path, time::Duration};
 
 use rt_benches::plot::{Plot, Series, loglog};
-use rt_cli::distributed::{surface, volume};
 use rt_composite::{Schedule, ThreadComm};
 use rt_core::Frame;
+use rt_tools::distributed::{surface, volume};
 
 use crate::{
     Section,

@@ -138,7 +138,7 @@ fn side_by_side(a: &Path, b: &Path, out: &Path) -> Result<(), String> {
             rgb.extend(row.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]));
         }
     }
-    rt_cli::image::write_rgb8(&rgb, 2 * w, h, out).map_err(|e| e.to_string())
+    rt_tools::image::write_rgb8(&rgb, 2 * w, h, out).map_err(|e| e.to_string())
 }
 
 fn counters(dir: &Path) -> Option<std::collections::HashMap<String, u64>> {

@@ -18,12 +18,11 @@ use rt_benches::{
     plot::{Plot, Series, loglog},
     scenes::{knife_bench, sparse_bumps},
 };
-use rt_cli::{
-    demo::blast_wave_with,
-    optics::{Source, lattice},
-    schlieren,
+use rt_photo::{
+    Bench, Film, Filter, Reconstruction, SchlierenOptions, SchlierenSetup, TraceParams,
+    build_octree, lattice,
 };
-use rt_photo::{Bench, Film, Filter, Mode, Reconstruction, TraceParams, build_octree};
+use rt_tools::builtin::blast_wave;
 
 use crate::{
     Section,
@@ -70,14 +69,11 @@ struct Row {
 pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     // The tool's defaults: knife edge, 512 px, 16 photons per pixel, its
     // default interpolant, the sheet estimator.
-    let defaults = schlieren::Args::from_args(Path::new("built-in"), ["--cutoff", "knife"])
-        .map_err(|e| e.to_string())?;
-    let volume = blast_wave_with(defaults.interp).map_err(|e| e.to_string())?;
-    let (bench, chosen) = schlieren::prepare(&volume, &defaults).map_err(|e| e.to_string())?;
-    let background = match &bench.mode {
-        Mode::Schlieren(c) => f64::from(c.transmit(0.0, 0.0)[0]),
-        Mode::Interferometry { .. } => 1.0,
-    };
+    let defaults = SchlierenOptions::default();
+    let volume = blast_wave().map_err(|e| e.to_string())?;
+    let setup = SchlierenSetup::choose(&volume, &defaults).map_err(|e| e.to_string())?;
+    let (bench, chosen) = (&setup.bench, setup.to_string());
+    let background = f64::from(setup.background()[0]);
     let size = if quick { 128 } else { defaults.size as usize };
     let counts: &[u32] = if quick { &[4, 16, 64] } else { &[4, 16, 64, 256] };
     // The reference: photons splatted with the box filter (each counted in
@@ -90,8 +86,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         let (strata, passes) = lattice(reference_n);
         let b = Bench { strata, reconstruction: Reconstruction::Photons, ..bench.clone() };
         for pass in 0..passes {
-            b.render_grid(&volume.field, &volume.tree, &mut film, pass, seed)
-                .map_err(|e| e.to_string())?;
+            b.render_medium(&volume, &mut film, pass, seed).map_err(|e| e.to_string())?;
         }
         Ok(film)
     };
@@ -111,14 +106,15 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         "estimator,photons_per_pixel,photons,seconds,noise_disturbed,noise_all,error_vs_reference\n",
     );
     let mut md = format!(
-        "Knife edge as `rt schlieren` chooses it ({chosen}), the built-in blast wave ({:?} interpolation, octree skipping and beam masks, leapfrog at two cells), {size}² pixels; {:.0} % of them disturbed (differing from the background {background} by more than 0.02 in the reference). \
+        "Knife edge as `rt schlieren` chooses it ({chosen}), the built-in blast wave ({} interpolation, octree skipping and beam masks, leapfrog at two cells), {size}² pixels; {:.0} % of them disturbed (differing from the background {background} by more than 0.02 in the reference). \
          Two estimators, each with the tool's lattice (k × k photons per pixel per pass, k = 2 below 64 photons per pixel, 4 from 64, 8 from 256; the passes shifted along the R2 sequence): **sheet** (`rt schlieren`'s: the photons of a pass form a lattice whose cells carry their light onto the film where their corners land, exact area, Abel, Hahn & Kaehler 2012) and **photons** (each photon splatted alone with the tent filter). \
          Noise is `rms(a − b)/√2` of two seeds, as a fraction of the background; error is the rms difference, over the disturbed pixels and in image units, from the reference: photons counted in the pixel they land in (box filter, unbiased), {reference_n} per pixel, the mean of two seeds (its own noise: {reference_noise:.1e}).\n\n\
          | estimator | photons/pixel | photons | seconds | M photons/s | noise (disturbed) / background | noise (all) / background | error vs reference |\n|---|---|---|---|---|---|---|---|\n",
-        defaults.interp,
+        "Catmull–Rom",
         100.0 * share
     );
     let mut rows = Vec::new();
+    let height = ((size as f64) * bench.height / bench.width).round().max(1.0) as usize;
     for sheet in [true, false] {
         let b = Bench {
             reconstruction: if sheet { Reconstruction::Sheet } else { Reconstruction::Photons },
@@ -126,8 +122,19 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         };
         let name = if sheet { "sheet" } else { "photons" };
         for &n in counts {
-            let (a, secs) = volume.render(&b, size, n, 1).map_err(|e| e.to_string())?;
-            let (c, _) = volume.render(&b, size, n, 2).map_err(|e| e.to_string())?;
+            let run = SchlierenSetup {
+                bench: b.clone(),
+                size: (size, height),
+                photons: n,
+                ..setup.clone()
+            };
+            let render = |seed: u64| -> Result<(Film, f64), String> {
+                let t = std::time::Instant::now();
+                let film = run.render(&volume, seed, &mut |_, _| {}).map_err(|e| e.to_string())?;
+                Ok((film, t.elapsed().as_secs_f64()))
+            };
+            let (a, secs) = render(1)?;
+            let (c, _) = render(2)?;
             let (nd, na) = noise(&a, &c, &disturbed);
             let (nd, na) = (nd / background, na / background);
             let err = error(&a, &reference, &disturbed);

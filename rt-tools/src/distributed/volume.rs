@@ -117,7 +117,7 @@ impl VolumeJob {
     /// # Errors
     /// `dir` cannot be written.
     pub fn builtin(dir: &Path, size: u32, strata: u32) -> anyhow::Result<Self> {
-        let file = crate::demo::write_blast_wave(dir)?;
+        let file = crate::builtin::write_blast_wave(dir)?;
         Ok(Self {
             file,
             samples: Samples::AIR,
@@ -581,5 +581,5 @@ pub fn rank<C: Communicator>(
 /// # Errors
 /// `dir` cannot be written.
 pub fn builtin_file(dir: &Path) -> anyhow::Result<PathBuf> {
-    crate::demo::write_blast_wave(dir)
+    crate::builtin::write_blast_wave(dir)
 }

@@ -25,12 +25,11 @@ use plotters::{
     style::text_anchor::{HPos, Pos, VPos},
 };
 use rt_core::{ColorMap, Frame, frame::linear_to_srgb};
-use rt_photo::FilterImage;
+use rt_photo::{FilterImage, units::si};
 
 use crate::{
     image::{WriteError, over_background, write_rgb8},
     text::{FAMILY, register_font_once, superscript},
-    units::si,
 };
 
 /// The image's longer side on the figure, in pixels.
@@ -74,7 +73,7 @@ type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 
 /// Why a figure could not be made.
 #[derive(Debug)]
-pub(crate) enum FigureError {
+pub enum FigureError {
     /// The embedded font could not be read (a damaged
     /// `assets/DejaVuSans.ttf`).
     Font,
@@ -112,7 +111,7 @@ impl From<DrawError> for FigureError {
 
 /// 8-bit sRGB RGB pixels, rows top first.
 #[derive(Clone, Debug)]
-pub(crate) struct Image {
+pub struct Image {
     width: u32,
     height: u32,
     rgb: Vec<u8>,
@@ -120,7 +119,7 @@ pub(crate) struct Image {
 
 impl Image {
     /// `frame` composited over white (a figure is opaque).
-    pub(crate) fn from_frame(frame: &Frame) -> Self {
+    pub fn from_frame(frame: &Frame) -> Self {
         let mut f = frame.clone();
         over_background(&mut f, [1.0; 3], [1.0; 3]);
         let rgb = f.to_srgba8().chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
@@ -128,7 +127,7 @@ impl Image {
     }
 
     /// 8-bit sRGB RGB pixels, rows top first (`w·h·3` bytes).
-    pub(crate) fn from_rgb8(width: u32, height: u32, rgb: Vec<u8>) -> Self {
+    pub fn from_rgb8(width: u32, height: u32, rgb: Vec<u8>) -> Self {
         debug_assert_eq!(rgb.len(), width as usize * height as usize * 3);
         Self { width, height, rgb }
     }
@@ -174,17 +173,17 @@ impl Image {
 
 /// One axis of an image in physical units.
 #[derive(Clone, Debug)]
-pub(crate) struct Axis {
+pub struct Axis {
     /// Its name, e.g. `x`.
-    pub(crate) name: String,
+    pub name: String,
     /// The coordinates at the image's edges in metres: left to right, or
     /// bottom to top.
-    pub(crate) range: Range<f64>,
+    pub range: Range<f64>,
 }
 
 /// What the figure shows beside the image.
 #[derive(Clone, Debug)]
-pub(crate) enum Legend {
+pub enum Legend {
     /// Nothing.
     None,
     /// The colour filter: its transmission over the deflection disc, hue =
@@ -213,18 +212,18 @@ pub(crate) enum Legend {
 
 /// A figure: the image, its texts, axes and legend.
 #[derive(Clone, Debug)]
-pub(crate) struct Figure {
+pub struct Figure {
     /// The picture.
-    pub(crate) image: Image,
+    pub image: Image,
     /// First line above it.
-    pub(crate) title: String,
+    pub title: String,
     /// Second, smaller line (the parameters).
-    pub(crate) subtitle: String,
+    pub subtitle: String,
     /// Horizontal and vertical axes in metres, or none (a perspective
     /// render has no such axes).
-    pub(crate) axes: Option<(Axis, Axis)>,
+    pub axes: Option<(Axis, Axis)>,
     /// Beside the image.
-    pub(crate) legend: Legend,
+    pub legend: Legend,
 }
 
 /// Registers the embedded font with plotters once per process.
@@ -244,7 +243,7 @@ impl Figure {
     ///
     /// # Errors
     /// [`FigureError`]: the font, plotters, or the file.
-    pub(crate) fn write(&self, path: &Path) -> Result<(), FigureError> {
+    pub fn write(&self, path: &Path) -> Result<(), FigureError> {
         register()?;
         let (dw, dh) = self.image.shown_size();
         let k = Scale::for_image(dw.max(dh));
@@ -674,7 +673,7 @@ fn common_exponent(a: f64, b: f64) -> i32 {
 
 /// `x` with 4 significant digits: plain from 10⁻³ to 10⁵, else as
 /// `m.mmm×10ⁿ`.
-pub(crate) fn significant(x: f64) -> String {
+pub fn significant(x: f64) -> String {
     if !x.is_finite() || x == 0.0 {
         return format!("{x}");
     }

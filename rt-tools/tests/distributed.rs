@@ -4,12 +4,12 @@
 
 use core::time::Duration;
 
-use rt_cli::distributed::{
+use rt_composite::{Communicator as _, Schedule, ThreadComm};
+use rt_core::{Frame, Pixel};
+use rt_tools::distributed::{
     surface::{self, SurfaceJob},
     volume,
 };
-use rt_composite::{Communicator as _, Schedule, ThreadComm};
-use rt_core::{Frame, Pixel};
 
 fn bits(f: &Frame) -> Vec<([u32; 4], u32)> {
     f.pixels().iter().map(|p: &Pixel| (p.color.map(f32::to_bits), p.depth.to_bits())).collect()

@@ -14,20 +14,17 @@
 //! **Surfaces** (the default): the terrain is cut into slabs of triangles
 //! by centroid along its longest axis; each rank builds a BVH over its
 //! slab only, shades the pixels its slab covers with shadow and AO rays
-//! answered by every rank whose region they cross (see [`surface`]), and
+//! answered by every rank whose region they cross (see `rt_tools::distributed::surface`), and
 //! the frames are z-composited.
 //!
 //! **Volumes** (`--volume [FILE]`): the grid is split into bricks, one per
 //! rank; each rank reads only its brick and its ghost layers from the
-//! file, and photons are handed from brick to brick (see [`volume`]);
+//! file, and photons are handed from brick to brick (see `rt_tools::distributed::volume`);
 //! rank 0 lands them on the film in the bench's fixed order.
 //!
 //! The image is written by rank 0, which also renders the whole mesh in
 //! one process and compares: the program exits non-zero if one bit of
 //! depth or colour differs.
-
-pub mod surface;
-pub mod volume;
 
 use std::{
     path::{Path, PathBuf},
@@ -40,10 +37,14 @@ use rt_composite::{Communicator, Schedule};
 use rt_core::{Frame, Pixel};
 use rt_photo::Film;
 
-use crate::{
+use rt_tools::{
+    distributed::{surface, volume},
     image::{film_frame, write_png},
-    optics::{Interpolation, Samples},
     output::Outputs,
+};
+
+use crate::{
+    optics::{Interpolation, Samples},
     parse,
 };
 

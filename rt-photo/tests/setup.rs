@@ -1,0 +1,149 @@
+//! The instruments set up from the data (`SchlierenSetup`, `BosSetup`,
+//! `FocusingSetup` over a `Medium`): what they choose, that one `render`
+//! over a medium is the per-field render it replaces, and that bad
+//! options are refused by name.
+
+use rt_photo::{
+    Axis, Bench, BosOptions, BosSetup, Cutoff, CutoffKind, Film, Filter, FocusingOptions,
+    FocusingSetup, Medium, Mode, SchlierenOptions, SchlierenSetup, SetupError, Survey,
+    glam::DVec3,
+    rt_volume::{GLADSTONE_DALE_AIR, Grid, Interp, Samples},
+};
+
+/// A Gaussian density bump `1.2 + amp·exp(−r²/2σ²)` on an `n³` grid of
+/// spacing `h` centred at the origin.
+fn bump(n: usize, h: f64, sigma: f64, amp: f64) -> Grid {
+    let c = 0.5 * (n as f64 - 1.0) * h;
+    let mut data = Vec::with_capacity(n * n * n);
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                let p = DVec3::new(i as f64, j as f64, k as f64) * h - c;
+                data.push((1.2 + amp * (-p.length_squared() / (2.0 * sigma * sigma)).exp()) as f32);
+            }
+        }
+    }
+    Grid::new([n; 3], DVec3::splat(-0.5 * n as f64 * h), DVec3::splat(h), data).unwrap()
+}
+
+fn medium(interp: Interp) -> Medium {
+    Medium::from_grid(bump(40, 1.5e-3, 8e-3, 0.3), Samples::AIR, false, interp).unwrap()
+}
+
+/// A weak flow (peak deflection ~1e-4 rad, below the skipping tolerance
+/// of a bench without cutoff) is measured, not skipped: the survey's
+/// largest deflection is the bump's analytic `K·A·√(2π)·e^(−1/2)` (see
+/// docs/oracles.md) within the coarse survey's sampling. Skipped, it would
+/// read 0 and the automatic exposure would saturate the knife edge.
+#[test]
+fn the_survey_measures_weak_flows() {
+    let (sigma, amp) = (8e-3, 0.3);
+    let m =
+        Medium::from_grid(bump(48, 1.5e-3, sigma, amp), Samples::AIR, false, Interp::CatmullRom)
+            .unwrap();
+    let probe = Bench::through(m.bounds(), Axis::Z, Mode::Schlieren(Cutoff::None), 0.0, m.params());
+    let survey = Survey::of(&m, &probe, Survey::WIDTH).unwrap();
+    let exact = GLADSTONE_DALE_AIR * amp * core::f64::consts::TAU.sqrt() * (-0.5f64).exp();
+    let got = survey.magnitude(1.0);
+    assert!((got / exact - 1.0).abs() < 0.1, "survey max |ε| {got:e}, analytic {exact:e}");
+}
+
+/// The automatic knife edge maps the 99th percentile of the deflection
+/// across it to 0.45 of its range: the image stays within 0.5 ± 0.45 but
+/// for about 1 % of the pixels, and uses that range (a knife edge chosen
+/// from |ε| instead of ε⊥, or off by a factor, fails one of the two).
+#[test]
+fn the_automatic_knife_edge_spends_its_range_on_the_flow() {
+    let m = medium(Interp::CatmullRom);
+    let o = SchlierenOptions { size: 64, photons: 4, ..SchlierenOptions::default() };
+    let setup = SchlierenSetup::choose(&m, &o).unwrap();
+    assert!(setup.to_string().starts_with("knife edge at 0°, f = 1.00 m, h = "), "{setup}");
+    let film = setup.render(&m, 1, &mut |_, _| {}).unwrap();
+    let image: Vec<f64> = film.normalized_f64().iter().map(|p| p[0]).collect();
+    let outside = image.iter().filter(|v| (**v - 0.5).abs() > 0.45 + 1e-9).count();
+    let deviation = image.iter().map(|v| (v - 0.5).abs()).fold(0.0, f64::max);
+    assert!(outside as f64 <= 0.02 * image.len() as f64, "{outside} of {} saturated", image.len());
+    assert!(deviation > 0.3, "largest |I − 0.5| only {deviation}");
+}
+
+/// A shadowgraph's film is placed where the strongest contrast is about
+/// 0.5; a colour filter's rim clears the deflections; interferometry
+/// takes the medium's ambient index as its reference.
+#[test]
+fn each_cutoff_chooses_from_the_data() {
+    let m = medium(Interp::Trilinear);
+    let choose = |cutoff| {
+        let o = SchlierenOptions { cutoff, size: 48, photons: 4, ..SchlierenOptions::default() };
+        SchlierenSetup::choose(&m, &o).unwrap()
+    };
+    let shadow = choose(CutoffKind::None);
+    assert!(shadow.bench.film_distance > 0.0 && shadow.title() == "Shadowgraph");
+    let colour = choose(CutoffKind::Color);
+    let Mode::Schlieren(Cutoff::Color(filter)) = &colour.bench.mode else { panic!("colour") };
+    let probe = Bench::through(m.bounds(), Axis::Z, Mode::Schlieren(Cutoff::None), 0.0, m.params());
+    let largest = Survey::of(&m, &probe, 48).unwrap().magnitude(1.0);
+    assert!(filter.half_range > 0.5 * largest && filter.half_range <= largest);
+    let Mode::Interferometry { n_ref, .. } = choose(CutoffKind::Interferometry).bench.mode else {
+        panic!("interferometry")
+    };
+    assert_eq!(n_ref, m.ambient());
+}
+
+/// One render over a medium is the per-field render it stands for, bit
+/// for bit: the octree's fast path for a grid.
+#[test]
+fn rendering_a_medium_is_the_grids_fast_path() {
+    let m = medium(Interp::CatmullRom);
+    let Medium::Grid(g) = &m else { panic!("a grid") };
+    let o = SchlierenOptions { size: 40, photons: 4, ..SchlierenOptions::default() };
+    let setup = SchlierenSetup::choose(&m, &o).unwrap();
+    let bench = Bench { strata: 2, ..setup.bench.clone() };
+    let (mut a, mut b) =
+        (Film::new(40, 40, Filter::Tent).unwrap(), Film::new(40, 40, Filter::Tent).unwrap());
+    bench.render_medium(&m, &mut a, 0, 7).unwrap();
+    bench.render_grid(g.field(), g.tree(), &mut b, 0, 7).unwrap();
+    assert_eq!(a.normalized_f64(), b.normalized_f64());
+}
+
+/// BOS and focusing set-ups render, and say what they chose.
+#[test]
+fn bos_and_focusing_set_up_from_the_flow() {
+    let m = medium(Interp::CatmullRom);
+    let bos = BosSetup::choose(&m, &BosOptions { size: 24, ..BosOptions::default() }).unwrap();
+    assert!(bos.to_string().starts_with("f/16, f = "), "{bos}");
+    let images = bos.render(&m, 1).unwrap();
+    assert_eq!((images.width, images.height), (24, 24));
+    assert!(images.displacement.iter().any(|d| d[0].hypot(d[1]) > 1e-3));
+    let o = FocusingOptions { size: 16, samples_per_axis: 2, ..FocusingOptions::default() };
+    let f = FocusingSetup::choose(&m, &o).unwrap();
+    assert!(f.to_string().contains("cutoff offset 0.25 pitch"), "{f}");
+    assert_eq!(f.render(&m, 1).unwrap().relative().len(), 16 * 16);
+}
+
+/// Bad options are refused by name, before any work.
+#[test]
+fn bad_options_are_refused_by_name() {
+    let m = medium(Interp::Trilinear);
+    let bad = |o: SchlierenOptions| SchlierenSetup::choose(&m, &o).unwrap_err().to_string();
+    let d = SchlierenOptions::default;
+    assert_eq!(bad(SchlierenOptions { angle: f64::NAN, ..d() }), "angle must be finite (got NaN)");
+    assert_eq!(bad(SchlierenOptions { h: Some(-1.0), ..d() }), "h must be finite and > 0 (got -1)");
+    assert_eq!(bad(SchlierenOptions { size: 0, ..d() }), "size must be 1 to 16384 (got 0)");
+    let many = SchlierenOptions { size: 16384, photons: 65536, ..d() };
+    assert!(matches!(SchlierenSetup::choose(&m, &many), Err(SetupError::TooManyPhotons { .. })));
+    let close = BosOptions {
+        rig: rt_photo::BosRigOptions {
+            camera_distance: Some(0.01),
+            focal_length: Some(0.05),
+            ..Default::default()
+        },
+        ..BosOptions::default()
+    };
+    assert!(matches!(BosSetup::choose(&m, &close), Err(SetupError::TooClose { .. })));
+    let pitch = FocusingOptions {
+        rig: rt_photo::FocusingRigOptions { grid_pitch: Some(f64::INFINITY), ..Default::default() },
+        ..FocusingOptions::default()
+    };
+    let e = FocusingSetup::choose(&m, &pitch).unwrap_err().to_string();
+    assert_eq!(e, "pitch must be finite and > 0 (got inf)");
+}
