@@ -18,7 +18,8 @@
 //!   rank) or a volume (photons handed between bricks) rendered across
 //!   ranks and checked against one process bit for bit.
 //!
-//! Not a stable API: unpublished, it changes with the tools.
+//! Not a stable API: it changes with the tools (it is packaged only
+//! because the `rt` program depends on it).
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 
 pub mod builtin;

@@ -87,7 +87,8 @@ fn volumes(job: &volume::VolumeJob, ranks: usize) -> (rt_photo::Film, Vec<volume
 /// held the whole grid.
 #[test]
 fn volumes_equal_one_process_bit_for_bit_and_no_rank_holds_the_grid() {
-    let dir = std::env::temp_dir().join(format!("rt-cli-test-distributed-{}", std::process::id()));
+    let dir =
+        std::env::temp_dir().join(format!("rt-tools-test-distributed-{}", std::process::id()));
     let knife = volume::VolumeJob::builtin(&dir, 40, 1).unwrap();
     let fringes = volume::VolumeJob {
         optics: volume::VolumeOptics::Interferometry { lambda: 10.6e-6, fringes: Some(0.04) },
@@ -176,7 +177,7 @@ impl rt_composite::Communicator for GoesSilent {
 /// and none hangs.
 #[test]
 fn a_rank_that_stops_answering_is_an_error_on_every_rank() {
-    let dir = std::env::temp_dir().join(format!("rt-cli-test-silent-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("rt-tools-test-silent-{}", std::process::id()));
     let vjob = volume::VolumeJob::builtin(&dir, 32, 1).unwrap();
     let sjob = SurfaceJob {
         size: (64, 48),

@@ -198,6 +198,31 @@ pub fn schlieren(delta: f64, eps: f64) -> f64 {
     left / 8.0 + one.total()[0]
 }
 
+/// The automatic knife edge's source height for a blob of `excess`
+/// kg/m³ on an 8³ grid of air, from the library's set-up over a medium
+/// (survey, choice, one render); NaN on an error.
+#[must_use]
+pub fn auto_knife(excess: f32) -> f64 {
+    use alloc::vec::Vec;
+    use rt_photo::glam::DVec3;
+    use rt_photo::rt_volume::{Grid, Interp};
+    use rt_photo::{Cutoff, Medium, Mode, Samples, SchlierenOptions, SchlierenSetup};
+    let data: Vec<f32> = (0..512).map(|i| if i == 292 { 1.2 + excess } else { 1.2 }).collect();
+    let Ok(grid) = Grid::new([8; 3], DVec3::ZERO, DVec3::splat(1e-3), data) else { return f64::NAN };
+    let Ok(medium) = Medium::from_grid(grid, Samples::AIR, false, Interp::Trilinear) else {
+        return f64::NAN;
+    };
+    let options = SchlierenOptions { size: 4, photons: 1, ..SchlierenOptions::default() };
+    let Ok(setup) = SchlierenSetup::choose(&medium, &options) else { return f64::NAN };
+    if setup.render(&medium, 1, &mut |_, _| {}).is_err() {
+        return f64::NAN;
+    }
+    match setup.bench.mode {
+        Mode::Schlieren(Cutoff::KnifeEdge { h, .. }) => h,
+        _ => f64::NAN,
+    }
+}
+
 /// C entry point so the static library exports something.
 ///
 /// # Safety
