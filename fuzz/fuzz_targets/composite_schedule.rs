@@ -6,7 +6,7 @@
 use std::time::Duration;
 
 use libfuzzer_sys::fuzz_target;
-use rt_composite::{Mode, Schedule, ThreadComm, composite, serial_fold};
+use rt_composite::{Operator, Schedule, ThreadComm, composite, serial_fold};
 use rt_core::Pixel;
 use rt_fuzz::{bits, pixel};
 
@@ -37,7 +37,7 @@ fuzz_target!(|data: &[u8]| {
         images.push(img);
     }
     let over = u.ratio(1u8, 3).unwrap_or(false);
-    let mode = if over { Mode::Over { order: (0..n).rev().collect() } } else { Mode::Depth };
+    let mode = if over { Operator::Over { order: (0..n).rev().collect() } } else { Operator::Depth };
     let schedule = if over { Schedule::DirectSend } else { schedule };
     if bad {
         images[n - 1].pop();

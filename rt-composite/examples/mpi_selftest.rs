@@ -19,7 +19,7 @@ mod support;
 use std::{process::ExitCode, time::Duration};
 
 use rt_composite::{
-    CommError, Communicator, Fragment, Mode, MpiComm, Pixel8, Schedule, composite,
+    CommError, Communicator, Fragment, MpiComm, Operator, Pixel8, Schedule, composite,
     mpi::{collective::SystemOperation, traits::CommunicatorCollectives},
     serial_fold,
 };
@@ -61,7 +61,7 @@ fn check_equal<F: Fragment>(
     all: &[Vec<F>],
     size: (u32, u32),
     s: Schedule,
-    m: &Mode,
+    m: &Operator,
     failures: &mut Vec<String>,
 ) {
     let what = format!("{s:?} {m:?} {}×{}", size.0, size.1);
@@ -101,11 +101,11 @@ fn main() -> ExitCode {
             let all: Vec<Vec<Pixel>> =
                 (0..n).map(|r| image(r as u64 * 31 + w as u64, (w * h) as usize, active)).collect();
             for s in schedules {
-                check_equal(&comm, &all[rank], &all, (w, h), s, &Mode::Depth, &mut failures);
+                check_equal(&comm, &all[rank], &all, (w, h), s, &Operator::Depth, &mut failures);
                 cases += 1;
             }
             let order: Vec<usize> = (0..n).rev().collect();
-            let over = Mode::Over { order };
+            let over = Operator::Over { order };
             check_equal(
                 &comm,
                 &all[rank],
@@ -125,7 +125,7 @@ fn main() -> ExitCode {
                 &all8,
                 (w, h),
                 Schedule::BinarySwap,
-                &Mode::Depth,
+                &Operator::Depth,
                 &mut failures,
             );
             cases += 2;
@@ -136,17 +136,17 @@ fn main() -> ExitCode {
     for s in schedules {
         // One rank claims 5×7 where the others say 7×5.
         let size = if rank == n - 1 && n > 1 { (5, 7) } else { (7, 5) };
-        if n > 1 && composite(&comm, &img, size.0, size.1, s, &Mode::Depth).is_ok() {
+        if n > 1 && composite(&comm, &img, size.0, size.1, s, &Operator::Depth).is_ok() {
             failures.push(format!("{s:?}: mismatched sizes were not an error"));
         }
         // One rank truncates every message it sends.
         let cut = Truncating(&comm, rank == n / 2);
-        if n > 1 && composite(&cut, &img, 7, 5, s, &Mode::Depth).is_ok() {
+        if n > 1 && composite(&cut, &img, 7, 5, s, &Operator::Depth).is_ok() {
             failures.push(format!("{s:?}: truncated messages were not an error"));
         }
         cases += 2;
     }
-    let over = Mode::Over { order: (0..n).collect() };
+    let over = Operator::Over { order: (0..n).collect() };
     if n > 1 && composite(&comm, &img, 7, 5, Schedule::BinarySwap, &over).is_ok() {
         failures.push("over with binary swap was not an error".into());
     }

@@ -32,7 +32,7 @@
 //!
 //! ```
 //! use core::time::Duration;
-//! use rt_composite::{Mode, Schedule, ThreadComm, composite, serial_fold};
+//! use rt_composite::{Operator, Schedule, ThreadComm, composite, serial_fold};
 //! use rt_core::Pixel;
 //!
 //! // Three ranks, each drew one pixel of a 4×1 image at its own depth.
@@ -49,12 +49,12 @@
 //!     let handles: Vec<_> = comms
 //!         .into_iter()
 //!         .zip(&images)
-//!         .map(|(c, img)| s.spawn(move || composite(&c, img, 4, 1, Schedule::BinarySwap, &Mode::Depth)))
+//!         .map(|(c, img)| s.spawn(move || composite(&c, img, 4, 1, Schedule::BinarySwap, &Operator::Depth)))
 //!         .collect();
 //!     handles.into_iter().map(|h| h.join().unwrap().unwrap()).collect()
 //! });
 //! let refs: Vec<&[Pixel]> = images.iter().map(Vec::as_slice).collect();
-//! let expected = serial_fold(&refs, &Mode::Depth).unwrap();
+//! let expected = serial_fold(&refs, &Operator::Depth).unwrap();
 //! assert_eq!(results[0].0.as_deref(), Some(&expected[..]));
 //! assert_eq!(expected[3].depth, 8.0); // the nearest of 10, 9, 8
 //! ```
@@ -82,7 +82,9 @@ pub use fragment::{Fragment, Pixel8, over, z_composite};
 #[cfg(feature = "mpi")]
 pub use mpi;
 pub use occlusion::{OcclusionError, OcclusionStats, RAY_BYTES, resolve_occlusion};
-pub use schedule::{CompositeError, MessageProblem, Mode, Schedule, Stats, composite, serial_fold};
+pub use schedule::{
+    CompositeError, MessageProblem, Operator, Schedule, Stats, composite, serial_fold,
+};
 pub use sparse::{DecodeError, SparseImage};
 
 /// The crate README's example, compiled and run as a doc test.

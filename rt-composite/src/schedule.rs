@@ -38,9 +38,9 @@ pub enum Schedule {
     RadixK(usize),
 }
 
-/// How fragments combine.
+/// How fragments combine: the compositing operator.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Mode {
+pub enum Operator {
     /// The nearer fragment; equal depths go to the lower rank.
     Depth,
     /// Ordered premultiplied `over`; `order[0]` is the rank in front.
@@ -86,7 +86,7 @@ pub enum CompositeError {
     BadRadix(usize),
     /// The visibility order is not a permutation of the ranks.
     BadOrder,
-    /// `Mode::Over` with a schedule other than direct send.
+    /// `Operator::Over` with a schedule other than direct send.
     OverNeedsDirectSend,
 }
 
@@ -166,14 +166,17 @@ pub struct Stats {
 /// # Errors
 /// [`CompositeError::ImageSize`] if the images differ in length,
 /// [`CompositeError::BadOrder`].
-pub fn serial_fold<F: Fragment>(images: &[&[F]], mode: &Mode) -> Result<Vec<F>, CompositeError> {
+pub fn serial_fold<F: Fragment>(
+    images: &[&[F]],
+    mode: &Operator,
+) -> Result<Vec<F>, CompositeError> {
     let n = images.first().map_or(0, |i| i.len());
     if let Some(bad) = images.iter().find(|i| i.len() != n) {
         return Err(CompositeError::ImageSize { expected: n, found: bad.len() });
     }
     let order: Vec<usize> = match mode {
-        Mode::Depth => (0..images.len()).collect(),
-        Mode::Over { order } => {
+        Operator::Depth => (0..images.len()).collect(),
+        Operator::Over { order } => {
             check_order(order, images.len())?;
             order.clone()
         }
@@ -187,10 +190,10 @@ pub fn serial_fold<F: Fragment>(images: &[&[F]], mode: &Mode) -> Result<Vec<F>, 
     Ok(out)
 }
 
-fn combine<F: Fragment>(mode: &Mode, front: F, back: F) -> F {
+fn combine<F: Fragment>(mode: &Operator, front: F, back: F) -> F {
     match mode {
-        Mode::Depth => front.z(back),
-        Mode::Over { .. } => front.over(back),
+        Operator::Depth => front.z(back),
+        Operator::Over { .. } => front.over(back),
     }
 }
 
@@ -360,7 +363,7 @@ pub fn composite<C: Communicator, F: Fragment>(
     width: u32,
     height: u32,
     schedule: Schedule,
-    mode: &Mode,
+    mode: &Operator,
 ) -> Result<(Option<Vec<F>>, Stats), CompositeError> {
     let (n, rank) = (comm.size(), comm.rank());
     if rank >= n {
@@ -386,14 +389,14 @@ pub fn composite<C: Communicator, F: Fragment>(
     // Virtual ranks: visibility positions for `over`, ranks for depth;
     // `order[v]` is the rank at virtual index `v`.
     let order: Vec<usize> = match mode {
-        Mode::Over { order } if check_order(order, n).is_ok() => order.clone(),
-        Mode::Over { .. } => {
+        Operator::Over { order } if check_order(order, n).is_ok() => order.clone(),
+        Operator::Over { .. } => {
             run.fail(CompositeError::BadOrder);
             (0..n).collect()
         }
-        Mode::Depth => (0..n).collect(),
+        Operator::Depth => (0..n).collect(),
     };
-    if matches!(mode, Mode::Over { .. }) && schedule != Schedule::DirectSend && n > 1 {
+    if matches!(mode, Operator::Over { .. }) && schedule != Schedule::DirectSend && n > 1 {
         run.fail(CompositeError::OverNeedsDirectSend);
     }
     let at = |v: usize| order[v];

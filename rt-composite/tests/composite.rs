@@ -7,13 +7,13 @@ use core::time::Duration;
 
 use proptest::prelude::*;
 use rt_composite::{
-    CommError, Communicator, CompositeError, DecodeError, Fragment, Mode, Pixel8, Schedule,
+    CommError, Communicator, CompositeError, DecodeError, Fragment, Operator, Pixel8, Schedule,
     SparseImage, ThreadComm, composite, serial_fold,
 };
 use rt_core::Pixel;
 use support::{bits, image, run, run_on};
 
-fn fold<F: Fragment>(images: &[Vec<F>], m: &Mode) -> Vec<F> {
+fn fold<F: Fragment>(images: &[Vec<F>], m: &Operator) -> Vec<F> {
     let refs: Vec<&[F]> = images.iter().map(Vec::as_slice).collect();
     serial_fold(&refs, m).unwrap()
 }
@@ -33,7 +33,7 @@ fn background_is_an_exact_identity_of_both_operators() {
 fn z_fold_is_the_nearest_fragment_with_ties_to_the_lower_rank() {
     // Against a direct argmin over (depth, rank), NaN depth as +∞.
     let images: Vec<Vec<Pixel>> = (0..7).map(|r| image(r, 500, 0.6)).collect();
-    let folded = fold(&images, &Mode::Depth);
+    let folded = fold(&images, &Operator::Depth);
     for (i, got) in folded.iter().enumerate() {
         let key = |p: &Pixel| if p.depth.is_nan() { f32::INFINITY } else { p.depth };
         let best = images
@@ -147,9 +147,9 @@ fn every_schedule_equals_the_serial_fold() {
             let active = [0.05, 0.5, 1.0][n % 3];
             let images: Vec<Vec<Pixel>> =
                 (0..n).map(|r| image((n * 100 + r) as u64, (w * h) as usize, active)).collect();
-            let expected = bits(&fold(&images, &Mode::Depth));
+            let expected = bits(&fold(&images, &Operator::Depth));
             for s in schedules {
-                let out = run(&images, (w, h), s, &Mode::Depth);
+                let out = run(&images, (w, h), s, &Operator::Depth);
                 for (r, o) in out.into_iter().enumerate() {
                     let (img, _) = o.unwrap_or_else(|e| panic!("{n} ranks {w}×{h} {s:?}: {e}"));
                     match img {
@@ -172,17 +172,17 @@ fn ordered_over_and_eight_bit_pixels_equal_the_serial_fold() {
         let images: Vec<Vec<Pixel>> = (0..n).map(|r| image(r as u64 + 77, 45, 0.7)).collect();
         // Visibility order: a rotation and reversal of the ranks.
         let order: Vec<usize> = (0..n).map(|i| (n - 1 - i + 2) % n).collect();
-        let m = Mode::Over { order };
+        let m = Operator::Over { order };
         let out = run(&images, (w, h), Schedule::DirectSend, &m);
         assert_eq!(bits(&out[0].as_ref().unwrap().0.clone().unwrap()), bits(&fold(&images, &m)));
 
         let eight: Vec<Vec<Pixel8>> =
             images.iter().map(|i| i.iter().map(|p| Pixel8::from_pixel(*p)).collect()).collect();
         for s in [Schedule::BinarySwap, Schedule::RadixK(3)] {
-            let out = run(&eight, (w, h), s, &Mode::Depth);
+            let out = run(&eight, (w, h), s, &Operator::Depth);
             assert_eq!(
                 out[0].as_ref().unwrap().0.as_deref(),
-                Some(&fold(&eight, &Mode::Depth)[..])
+                Some(&fold(&eight, &Operator::Depth)[..])
             );
         }
     }
@@ -207,7 +207,7 @@ fn an_over_that_makes_the_background_is_encoded_as_background() {
             images.iter().map(|i| SparseImage::encode(0, i)).collect();
         let combined = sparse[0].combine(&sparse[1], Pixel::over).unwrap();
         assert!(SparseImage::<Pixel>::from_bytes(&combined.to_bytes()).is_ok());
-        let mode = Mode::Over { order: vec![0, 1] };
+        let mode = Operator::Over { order: vec![0, 1] };
         let expected = bits(&fold(&images, &mode));
         for (r, o) in run(&images, (2, 2), Schedule::DirectSend, &mode).into_iter().enumerate() {
             let (img, _) = o.unwrap_or_else(|e| panic!("rank {r}: {e}"));
@@ -224,7 +224,7 @@ fn background_is_never_sent() {
     // Eight ranks of 64×64 with nothing drawn: messages carry headers only.
     let images = vec![vec![Pixel::BACKGROUND; 64 * 64]; 8];
     for s in [Schedule::DirectSend, Schedule::BinarySwap, Schedule::RadixK(4)] {
-        let sent: usize = run(&images, (64, 64), s, &Mode::Depth)
+        let sent: usize = run(&images, (64, 64), s, &Operator::Depth)
             .into_iter()
             .map(|o| o.unwrap().1.bytes_sent)
             .sum();
@@ -292,7 +292,7 @@ fn a_failure_anywhere_is_an_err_everywhere_without_hanging() {
             // One rank's image is of another size.
             let mut wrong = images.clone();
             wrong[n - 1] = image(1, 36, 0.8);
-            let sizes_ok = run(&wrong, (7, 5), s, &Mode::Depth);
+            let sizes_ok = run(&wrong, (7, 5), s, &Operator::Depth);
             assert!(sizes_ok.iter().all(Result::is_err), "{s:?} {n}: {sizes_ok:?}");
             // One rank says 6×6 where the others say 7×5 (same pixel count
             // as its own image).
@@ -305,7 +305,7 @@ fn a_failure_anywhere_is_an_err_everywhere_without_hanging() {
                     .map(|(r, (c, img))| {
                         scope.spawn(move || {
                             let size = if r == 1 { (5, 7) } else { (7, 5) };
-                            composite(&c, img, size.0, size.1, s, &Mode::Depth)
+                            composite(&c, img, size.0, size.1, s, &Operator::Depth)
                         })
                     })
                     .collect();
@@ -324,7 +324,7 @@ fn a_failure_anywhere_is_an_err_everywhere_without_hanging() {
                         }
                     })
                     .collect();
-            let out = run_on(comms, &images, (7, 5), s, &Mode::Depth);
+            let out = run_on(comms, &images, (7, 5), s, &Operator::Depth);
             assert!(out.iter().all(Result::is_err), "{s:?} {n}: {out:?}");
         }
     }
@@ -332,15 +332,19 @@ fn a_failure_anywhere_is_an_err_everywhere_without_hanging() {
     let mut comms = ThreadComm::group(4, Duration::from_millis(300));
     drop(comms.pop());
     let images: Vec<Vec<Pixel>> = (0..3).map(|r| image(r, 16, 0.5)).collect();
-    let out = run_on(comms, &images, (4, 4), Schedule::BinarySwap, &Mode::Depth);
+    let out = run_on(comms, &images, (4, 4), Schedule::BinarySwap, &Operator::Depth);
     assert!(out.iter().all(Result::is_err), "{out:?}");
     // Bad arguments are errors on every rank too.
     let images: Vec<Vec<Pixel>> = (0..4).map(|r| image(r, 16, 0.5)).collect();
-    let over = Mode::Over { order: vec![3, 2, 1, 0] };
+    let over = Operator::Over { order: vec![3, 2, 1, 0] };
     for (s, m, e) in [
         (Schedule::BinarySwap, over.clone(), CompositeError::OverNeedsDirectSend),
-        (Schedule::DirectSend, Mode::Over { order: vec![0, 0, 1, 2] }, CompositeError::BadOrder),
-        (Schedule::RadixK(1), Mode::Depth, CompositeError::BadRadix(1)),
+        (
+            Schedule::DirectSend,
+            Operator::Over { order: vec![0, 0, 1, 2] },
+            CompositeError::BadOrder,
+        ),
+        (Schedule::RadixK(1), Operator::Depth, CompositeError::BadRadix(1)),
     ] {
         for o in run(&images, (4, 4), s, &m) {
             assert_eq!(o.unwrap_err(), e);

@@ -5,7 +5,7 @@
 
 mod support;
 
-use rt_composite::{Fragment, Mode, Schedule};
+use rt_composite::{Fragment, Operator, Schedule};
 use rt_core::Pixel;
 use support::bits;
 
@@ -13,7 +13,7 @@ const SCHEDULES: [Schedule; 4] =
     [Schedule::DirectSend, Schedule::BinarySwap, Schedule::RadixK(3), Schedule::RadixK(4)];
 
 /// Rank 0's composited image for `images` (one per rank), `w × h`.
-fn run(images: &[Vec<Pixel>], w: u32, h: u32, s: Schedule, m: &Mode) -> Vec<Pixel> {
+fn run(images: &[Vec<Pixel>], w: u32, h: u32, s: Schedule, m: &Operator) -> Vec<Pixel> {
     let out = support::run(images, (w, h), s, m);
     let mut first = None;
     for (r, o) in out.into_iter().enumerate() {
@@ -42,7 +42,11 @@ fn all_equal_depths_give_rank_zero_everywhere() {
             })
             .collect();
         for s in SCHEDULES {
-            assert_eq!(bits(&run(&images, w, h, s, &Mode::Depth)), bits(&images[0]), "{n} {s:?}");
+            assert_eq!(
+                bits(&run(&images, w, h, s, &Operator::Depth)),
+                bits(&images[0]),
+                "{n} {s:?}"
+            );
         }
     }
 }
@@ -69,7 +73,7 @@ fn depths_one_ulp_apart_at_every_magnitude() {
         })
         .collect();
     for s in SCHEDULES {
-        let out = run(&images, len as u32, 1, s, &Mode::Depth);
+        let out = run(&images, len as u32, 1, s, &Operator::Depth);
         for (i, p) in out.iter().enumerate() {
             let winner = (0..n).find(|r| (r + i) % n == 0).expect("some rank has 0 ulps");
             assert_eq!(p.color[0], winner as f32, "{s:?} pixel {i} ({:e})", mags[i]);
@@ -97,7 +101,7 @@ fn infinite_and_nan_depths_and_nan_colours() {
         .map(|r| cases.iter().map(|(d, _)| Pixel { color: c(r as f32), depth: d[r] }).collect())
         .collect();
     for s in SCHEDULES {
-        let out = run(&images, cases.len() as u32, 1, s, &Mode::Depth);
+        let out = run(&images, cases.len() as u32, 1, s, &Operator::Depth);
         for (i, (p, (d, winner))) in out.iter().zip(&cases).enumerate() {
             assert_eq!(p.color[0], *winner as f32, "{s:?} case {i}");
             assert_eq!(p.depth.to_bits(), d[*winner].to_bits(), "{s:?} case {i}");
@@ -125,7 +129,7 @@ fn over_with_extreme_alphas_stays_in_range() {
         })
         .collect();
     let order: Vec<usize> = (0..n).collect();
-    let out = run(&images, alphas.len() as u32, 1, Schedule::DirectSend, &Mode::Over { order });
+    let out = run(&images, alphas.len() as u32, 1, Schedule::DirectSend, &Operator::Over { order });
     for (i, p) in out.iter().enumerate() {
         assert!(p.color.iter().all(|v| (0.0..=1.0).contains(v)), "pixel {i}: {p:?}");
         let front = images[0][i];

@@ -9,7 +9,7 @@ use numpy::{
     ndarray::{Array2, Array3},
 };
 use pyo3::{exceptions::PyTimeoutError, prelude::*, types::PyBytes};
-use rt_composite::{CommError, Communicator, Mode, Schedule, serial_fold};
+use rt_composite::{CommError, Communicator, Operator, Schedule, serial_fold};
 use rt_core::Pixel;
 
 use crate::value_error;
@@ -90,7 +90,7 @@ pub(crate) fn composite<'py>(
     }
     let (w, h) = size.unwrap_or((0, 0));
     let refs: Vec<&[Pixel]> = images.iter().map(Vec::as_slice).collect();
-    let out = py.detach(|| serial_fold(&refs, &Mode::Depth)).map_err(value_error)?;
+    let out = py.detach(|| serial_fold(&refs, &Operator::Depth)).map_err(value_error)?;
     arrays(py, w, h, &out)
 }
 
@@ -189,7 +189,8 @@ pub(crate) fn composite_comm<'py>(
     let size: usize = comm.call_method0(py, "size")?.extract(py)?;
     let c = PyComm { obj: comm, rank, size, error: Mutex::new(None) };
     let (w32, h32) = (w as u32, h as u32);
-    let result = py.detach(|| rt_composite::composite(&c, &px, w32, h32, schedule, &Mode::Depth));
+    let result =
+        py.detach(|| rt_composite::composite(&c, &px, w32, h32, schedule, &Operator::Depth));
     match result {
         Ok((Some(out), _)) => Ok(Some(arrays(py, w, h, &out)?)),
         Ok((None, _)) => Ok(None),

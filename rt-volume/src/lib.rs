@@ -65,7 +65,6 @@ mod field;
 mod grid;
 #[cfg(feature = "io")]
 pub mod io;
-mod mapping;
 mod math;
 #[cfg(feature = "alloc")]
 mod medium;
@@ -74,6 +73,7 @@ pub mod mesh;
 #[cfg(feature = "alloc")]
 mod partition;
 mod reach;
+mod refractivity;
 #[cfg(feature = "alloc")]
 pub mod skip;
 #[cfg(feature = "alloc")]
@@ -88,7 +88,6 @@ pub use brick::{BrickError, BrickField, GridInfo, IndexBounds};
 pub use field::{Bounds, IndexField};
 #[cfg(feature = "alloc")]
 pub use grid::{Grid, GridError, GridField, GridSamples, Interp};
-pub use mapping::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
 #[cfg(feature = "io")]
 pub use medium::MediumOptions;
 #[cfg(feature = "alloc")]
@@ -98,6 +97,7 @@ pub use mesh::{Cell, MeshError, SmoothField, UnstructuredField};
 #[cfg(feature = "alloc")]
 pub use partition::Bricks;
 pub use reach::step_reach;
+pub use refractivity::{GLADSTONE_DALE_AIR, Sum, air_index_edlen, gladstone_dale};
 #[cfg(feature = "alloc")]
 pub use skip::{
     BRICK, BeamMask, BeamWindow, MAX_BEAM_CELLS, OctNode, Octree, OctreeError, SmoothNode,

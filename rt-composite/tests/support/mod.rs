@@ -6,7 +6,7 @@
 use core::time::Duration;
 
 use rt_composite::{
-    Communicator, CompositeError, Fragment, Mode, Schedule, Stats, ThreadComm, composite,
+    Communicator, CompositeError, Fragment, Operator, Schedule, Stats, ThreadComm, composite,
 };
 use rt_core::Pixel;
 
@@ -64,7 +64,7 @@ pub(crate) fn run_on<C, F>(
     images: &[Vec<F>],
     size: (u32, u32),
     s: Schedule,
-    m: &Mode,
+    m: &Operator,
 ) -> Vec<Outcome<F>>
 where
     C: Communicator + Send,
@@ -85,7 +85,7 @@ pub(crate) fn run<F: Fragment>(
     images: &[Vec<F>],
     size: (u32, u32),
     s: Schedule,
-    m: &Mode,
+    m: &Operator,
 ) -> Vec<Outcome<F>> {
     run_on(ThreadComm::group(images.len(), Duration::from_secs(20)), images, size, s, m)
 }

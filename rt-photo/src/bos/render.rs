@@ -23,7 +23,7 @@ use rt_core::sampling::{rng_for, uniform_f64};
 use rt_volume::{GridField, IndexField, Octree, TraceError, TraceParams, TraceResult, trace};
 
 use super::Background;
-use crate::camera::{CameraError, Frame, ThinLens};
+use crate::camera::{Basis, CameraError, ThinLens};
 use crate::rows::rows;
 
 /// A BOS set-up: `camera` focused on the background at `background_distance`
@@ -227,7 +227,7 @@ impl Bos {
 
     /// Where the ray from `origin` along `d` meets the background plane,
     /// as `(u, v)` on it (the camera's right and up axes).
-    fn on_background(&self, f: &Frame, origin: DVec3, d: DVec3) -> (f64, f64) {
+    fn on_background(&self, f: &Basis, origin: DVec3, d: DVec3) -> (f64, f64) {
         let plane = self.camera.position + self.background_distance * f.axis;
         let t = (plane - origin).dot(f.axis) / d.dot(f.axis);
         let p = origin + t * d - plane;
@@ -241,7 +241,7 @@ impl Bos {
         seed: u64,
     ) -> Result<Vec<Pixel>, BosError> {
         let cam = &self.camera;
-        let f = cam.frame();
+        let f = cam.basis();
         let k = self.aperture_samples;
         let n = f64::from(k * k);
         let to_px = cam.magnification() / cam.pixel_pitch;

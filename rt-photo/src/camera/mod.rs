@@ -11,5 +11,5 @@ mod thin_lens;
 pub use airy::{Airy, AiryKernel};
 pub use sensor::Sensor;
 pub use sensor_error::SensorError;
-pub(crate) use thin_lens::Frame;
+pub(crate) use thin_lens::Basis;
 pub use thin_lens::{CameraError, ThinLens};

@@ -39,9 +39,9 @@ pub struct ThinLens {
     pub height: usize,
 }
 
-/// The camera's orthonormal frame.
+/// The camera's orthonormal basis: its axis, right and up.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Frame {
+pub(crate) struct Basis {
     pub(crate) axis: DVec3,
     pub(crate) right: DVec3,
     pub(crate) up: DVec3,
@@ -106,10 +106,10 @@ impl ThinLens {
         why.map_or(Ok(()), |w| Err(CameraError(w)))
     }
 
-    pub(crate) fn frame(&self) -> Frame {
+    pub(crate) fn basis(&self) -> Basis {
         let axis = self.direction.normalize();
         let right = axis.cross(self.up).normalize();
-        Frame { axis, right, up: right.cross(axis) }
+        Basis { axis, right, up: right.cross(axis) }
     }
 
     /// The point of the focus plane that pixel coordinates `(px, py)`
@@ -117,12 +117,12 @@ impl ThinLens {
     /// downward) see in focus.
     #[must_use]
     pub fn focus_point(&self, px: f64, py: f64) -> DVec3 {
-        self.focus_point_in(&self.frame(), px, py)
+        self.focus_point_in(&self.basis(), px, py)
     }
 
     /// [`ThinLens::focus_point`] in the camera's frame `f`, computed once
     /// by the caller.
-    fn focus_point_in(&self, f: &Frame, px: f64, py: f64) -> DVec3 {
+    fn focus_point_in(&self, f: &Basis, px: f64, py: f64) -> DVec3 {
         let scale = self.pixel_pitch / self.magnification();
         self.position
             + self.focus_distance * f.axis
@@ -142,7 +142,7 @@ impl ThinLens {
     /// (along the camera's right and up, in aperture radii).
     #[must_use]
     pub fn ray_from(&self, px: f64, py: f64, (dx, dy): (f64, f64)) -> (DVec3, DVec3) {
-        let f = self.frame();
+        let f = self.basis();
         let r = 0.5 * self.aperture();
         let origin = self.position + r * (dx * f.right + dy * f.up);
         (origin, (self.focus_point_in(&f, px, py) - origin).normalize())

@@ -47,7 +47,7 @@ use glam::DVec3;
 use rt_core::sampling::{rng_for, uniform_f64};
 use rt_volume::{GridField, IndexField, Octree, TraceError, TraceParams, TraceResult, trace};
 
-use crate::camera::{Frame, ThinLens};
+use crate::camera::{Basis, ThinLens};
 use crate::math::{atan2, cos, floor, sin, sqrt};
 
 /// The source grid: bright bands of width `duty · pitch`, `pitch` apart,
@@ -410,7 +410,7 @@ impl FocusingSchlieren {
     ) -> Result<FocusingImages, FocusingError> {
         self.validate()?;
         let (w, h) = (self.camera.width, self.camera.height);
-        let frame = self.camera.frame();
+        let frame = self.camera.basis();
         let rows = crate::rows::rows(h, |j| self.row(tracer, &frame, j, seed));
         let mut out = FocusingImages {
             width: w,
@@ -429,7 +429,7 @@ impl FocusingSchlieren {
 
     /// Where the line from `origin` along `d` meets the source plane,
     /// across the bands.
-    fn on_source(&self, f: &Frame, origin: DVec3, d: DVec3) -> f64 {
+    fn on_source(&self, f: &Basis, origin: DVec3, d: DVec3) -> f64 {
         let plane = self.camera.position + self.source_distance * f.axis;
         let t = (plane - origin).dot(f.axis) / d.dot(f.axis);
         let p = origin + t * d - plane;
@@ -456,7 +456,7 @@ impl FocusingSchlieren {
     fn row(
         &self,
         tracer: &impl Fn(DVec3, DVec3) -> Result<TraceResult, TraceError>,
-        f: &Frame,
+        f: &Basis,
         j: usize,
         seed: u64,
     ) -> Result<Vec<[f64; 2]>, FocusingError> {

@@ -21,7 +21,7 @@ use std::time::Instant;
 use anyhow::{Context, anyhow, bail};
 use rayon::prelude::*;
 use rt_composite::{
-    Communicator, Mode, OcclusionStats, Schedule, Stats, composite, exchange::all_gather,
+    Communicator, OcclusionStats, Operator, Schedule, Stats, composite, exchange::all_gather,
     resolve_occlusion,
 };
 use rt_core::{Aabb, Camera, ColorMap, Frame, Projection, SceneQuery, glam::Vec3};
@@ -241,7 +241,7 @@ pub fn rank<C: Communicator>(
     report.covered = frame.pixels().iter().filter(|p| p.depth.is_finite()).count();
     let t = Instant::now();
     let (image, stats) =
-        composite(comm, frame.pixels(), job.size.0, job.size.1, job.schedule, &Mode::Depth)
+        composite(comm, frame.pixels(), job.size.0, job.size.1, job.schedule, &Operator::Depth)
             .with_context(|| format!("rank {me}"))?;
     report.seconds[3] = t.elapsed().as_secs_f64();
     report.composite = stats;

@@ -7,7 +7,7 @@
 
 use std::{fmt::Write as _, hint::black_box, path::Path, time::Duration};
 
-use rt_composite::{Fragment, Mode, Schedule, ThreadComm, composite, serial_fold};
+use rt_composite::{Fragment, Operator, Schedule, ThreadComm, composite, serial_fold};
 use rt_core::Pixel;
 
 use crate::{
@@ -70,7 +70,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             for active in [1.0, 0.5, 0.05] {
                 let images: Vec<Vec<Pixel>> = (0..n).map(|r| image(r, len, active)).collect();
                 let refs: Vec<&[Pixel]> = images.iter().map(Vec::as_slice).collect();
-                let expected = serial_fold(&refs, &Mode::Depth).map_err(|e| e.to_string())?;
+                let expected = serial_fold(&refs, &Operator::Depth).map_err(|e| e.to_string())?;
                 drop(refs);
                 for (name, schedule) in [
                     ("direct-send", Schedule::DirectSend),
@@ -89,7 +89,14 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
                                     .zip(&images)
                                     .map(|(c, img)| {
                                         s.spawn(move || {
-                                            composite(&c, img, side, side, schedule, &Mode::Depth)
+                                            composite(
+                                                &c,
+                                                img,
+                                                side,
+                                                side,
+                                                schedule,
+                                                &Operator::Depth,
+                                            )
                                         })
                                     })
                                     .collect();
