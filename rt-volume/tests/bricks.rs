@@ -604,3 +604,35 @@ fn path_state_round_trips_through_words_and_refuses_garbage() {
     assert!(PathState::from_words(&none).is_ok());
     assert_eq!(PathState::from_words(&[0.0; PathState::WORDS]), Err(TraceError::InvalidState));
 }
+
+/// A finished ray's result crosses the wire exactly, every exit kind;
+/// words no result writes are refused.
+#[test]
+fn trace_results_round_trip_through_words_and_refuse_garbage() {
+    let g = grid();
+    let cell = g.spacing().min_element();
+    let field = GridField::new(g, Interp::CatmullRom, AMBIENT).unwrap();
+    let mut results = Vec::new();
+    for (origin, max_steps) in [
+        (DVec3::new(0.1, 0.0, -1.0), 100_000),
+        (DVec3::new(5.0, 5.0, -1.0), 100_000),
+        (DVec3::new(0.1, 0.0, -1.0), 3),
+    ] {
+        let p = TraceParams { max_steps, ..params(Method::Adaptive, cell) };
+        results.push(trace(&field, origin, DVec3::Z, &p).unwrap());
+    }
+    let exits: Vec<Exit> = results.iter().map(|r| r.exit).collect();
+    assert_eq!(exits, [Exit::Left, Exit::Missed, Exit::MaxSteps]);
+    for r in &results {
+        let w = r.to_words();
+        let back = TraceResult::from_words(&w).unwrap();
+        assert_eq!(back.to_words().map(f64::to_bits), w.map(f64::to_bits));
+        assert_eq!(back, *r);
+    }
+    let w = results[0].to_words();
+    for (i, v) in [(7, 4.0), (7, 0.5), (7, -1.0), (8, -1.0), (9, 2.5), (10, 5e9), (13, f64::NAN)] {
+        let mut b = w;
+        b[i] = v;
+        assert_eq!(TraceResult::from_words(&b), Err(TraceError::InvalidState), "word {i} = {v}");
+    }
+}

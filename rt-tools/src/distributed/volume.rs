@@ -67,7 +67,7 @@ pub const PHOTON_BYTES: usize = 8 * (6 + PathState::WORDS);
 
 /// Bytes of a finished photon's result sent to rank 0: its identity and
 /// 15 words of [`TraceResult`].
-pub const RESULT_BYTES: usize = 8 * (6 + 15);
+pub const RESULT_BYTES: usize = 8 * (6 + TraceResult::WORDS);
 
 /// What a volume render records.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -310,40 +310,18 @@ pub fn same(a: &Film, b: &Film) -> bool {
     a.width() == b.width() && a.height() == b.height() && bits(a) == bits(b)
 }
 
-const EXIT: [Exit; 4] = [Exit::Missed, Exit::Left, Exit::MaxSteps, Exit::MaxLength];
-
 fn put_f64s(out: &mut Vec<u8>, v: &[f64]) {
     for x in v {
         out.extend(x.to_bits().to_le_bytes());
     }
 }
 
+/// A photon's identity and its result (`TraceResult`'s own words).
 fn put_result(out: &mut Vec<u8>, k: &Key, r: &TraceResult) {
     for w in k {
         out.extend(w.to_le_bytes());
     }
-    let s = &r.stats;
-    let exit = EXIT.iter().position(|e| *e == r.exit).unwrap_or(0);
-    put_f64s(
-        out,
-        &[
-            r.position.x,
-            r.position.y,
-            r.position.z,
-            r.direction.x,
-            r.direction.y,
-            r.direction.z,
-            r.optical_path,
-            exit as f64,
-            f64::from(s.steps),
-            f64::from(s.field_evals),
-            f64::from(s.rejected),
-            s.error_estimate,
-            s.invariant_drift,
-            f64::from(s.skipped),
-            s.skip_bound,
-        ],
-    );
+    put_f64s(out, &r.to_words());
 }
 
 /// Little-endian words off a batch.
@@ -369,29 +347,11 @@ impl Words<'_> {
 
 fn get_result(w: &mut Words<'_>) -> Option<(Key, TraceResult)> {
     let k = w.key()?;
-    let mut v = [0f64; 15];
+    let mut v = [0f64; TraceResult::WORDS];
     for x in &mut v {
         *x = w.f64()?;
     }
-    let count =
-        |x: f64| (x >= 0.0 && x <= f64::from(u32::MAX) && x.fract() == 0.0).then_some(x as u32);
-    let exit = *EXIT.get(count(v[7])? as usize)?;
-    let r = TraceResult {
-        position: DVec3::new(v[0], v[1], v[2]),
-        direction: DVec3::new(v[3], v[4], v[5]),
-        optical_path: v[6],
-        exit,
-        stats: TraceStats {
-            steps: count(v[8])?,
-            field_evals: count(v[9])?,
-            rejected: count(v[10])?,
-            error_estimate: v[11],
-            invariant_drift: v[12],
-            skipped: count(v[13])?,
-            skip_bound: v[14],
-        },
-    };
-    Some((k, r))
+    Some((k, TraceResult::from_words(&v).ok()?))
 }
 
 /// Reads this rank's brick with enough ghost layers for every step: first

@@ -1,12 +1,14 @@
 //! A ray's whole integration state between two legs of a distributed
-//! trace, and its encoding as a fixed number of f64 words (for the
-//! network).
+//! trace, and the wire format of a distributed trace: that state and a
+//! finished ray's result, each as a fixed number of f64 words (for the
+//! network; bit-exact, so a trace handed between ranks is the trace of
+//! one process).
 
 use glam::DVec3;
 
 use super::eval::State;
 use super::walk::unit;
-use super::{TraceError, TraceStats};
+use super::{Exit, TraceError, TraceResult, TraceStats};
 
 /// A ray's whole integration state between two legs of a distributed
 /// trace ([`trace_begin`](crate::trace_begin), [`trace_leg`](crate::trace_leg)):
@@ -111,9 +113,6 @@ impl PathState {
                 None
             }
         };
-        let count = |v: f64| {
-            (v >= 0.0 && v <= f64::from(u32::MAX) && v == (v as u32) as f64).then_some(v as u32)
-        };
         let sum = |v: f64| v >= 0.0;
         let (Some(has_last), Some(entered)) = (flag(w[18]), flag(w[26])) else {
             return bad;
@@ -159,5 +158,75 @@ impl PathState {
             skip_bound: w[17],
         };
         Ok(Self { y, h, max_step, chord, stats, last, entered })
+    }
+}
+
+/// The exits in their wire order.
+const EXITS: [Exit; 4] = [Exit::Missed, Exit::Left, Exit::MaxSteps, Exit::MaxLength];
+
+/// `v` as a count if it is an integer in `u32`'s range.
+fn count(v: f64) -> Option<u32> {
+    (v >= 0.0 && v <= f64::from(u32::MAX) && v == (v as u32) as f64).then_some(v as u32)
+}
+
+impl TraceResult {
+    /// Words in [`TraceResult::to_words`].
+    pub const WORDS: usize = 15;
+
+    /// The result as words, bit-exact: position (3), direction (3),
+    /// optical path, the exit (0 missed, 1 left, 2 out of steps, 3 out of
+    /// length), then the [`TraceStats`] in declaration order.
+    #[must_use]
+    pub fn to_words(&self) -> [f64; Self::WORDS] {
+        let s = &self.stats;
+        let exit = EXITS.iter().position(|e| *e == self.exit).unwrap_or(0);
+        let (p, d) = (self.position, self.direction);
+        [
+            p.x,
+            p.y,
+            p.z,
+            d.x,
+            d.y,
+            d.z,
+            self.optical_path,
+            exit as f64,
+            f64::from(s.steps),
+            f64::from(s.field_evals),
+            f64::from(s.rejected),
+            s.error_estimate,
+            s.invariant_drift,
+            f64::from(s.skipped),
+            s.skip_bound,
+        ]
+    }
+
+    /// The result [`TraceResult::to_words`] wrote, checked: the exit one
+    /// of the four, counts integers in `u32`'s range.
+    ///
+    /// # Errors
+    /// [`TraceError::InvalidState`] for words no result writes.
+    pub fn from_words(w: &[f64; Self::WORDS]) -> Result<Self, TraceError> {
+        let bad = TraceError::InvalidState;
+        let exit = *count(w[7]).and_then(|e| EXITS.get(e as usize)).ok_or(bad)?;
+        let (Some(steps), Some(field_evals), Some(rejected), Some(skipped)) =
+            (count(w[8]), count(w[9]), count(w[10]), count(w[13]))
+        else {
+            return Err(bad);
+        };
+        Ok(Self {
+            position: DVec3::new(w[0], w[1], w[2]),
+            direction: DVec3::new(w[3], w[4], w[5]),
+            optical_path: w[6],
+            exit,
+            stats: TraceStats {
+                steps,
+                field_evals,
+                rejected,
+                error_estimate: w[11],
+                invariant_drift: w[12],
+                skipped,
+                skip_bound: w[14],
+            },
+        })
     }
 }
