@@ -1,0 +1,74 @@
+//! Recording a draw once in the entry space of the modelview at its call,
+//! and instancing the recording: what the list and buffer-draw caches share.
+
+use std::sync::Arc;
+
+use glam::{Mat3, Mat4, Vec3, Vec4};
+
+use super::{Geometry, Recorded, Recorder, Shading};
+
+/// The inherited state a cached list's geometry depends on.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Inherited {
+    pub(super) color: Vec4,
+    pub(super) normal: Vec3,
+    pub(super) shading: Shading,
+    /// Definitions seen (lists that call others).
+    generation: u64,
+}
+
+pub(super) struct Capture {
+    pub(super) geometry: Geometry,
+    /// Eye space to the list's entry space.
+    pub(super) to_local: Mat4,
+    /// Eye-space normals to entry space.
+    pub(super) normal_to_local: Mat3,
+}
+
+impl Recorder {
+    /// The state a cached draw inherits; `generation`: the list
+    /// definitions it depends on (0: none).
+    pub(super) fn inherited(&self, generation: u64) -> Inherited {
+        Inherited { color: self.color, normal: self.normal, shading: self.shading(), generation }
+    }
+
+    /// Runs `f` with its geometry recorded in the entry space of the
+    /// modelview `mv` (`to_local` its inverse).
+    pub(super) fn captured(
+        &mut self,
+        mv: Mat4,
+        to_local: Mat4,
+        f: impl FnOnce(&mut Self),
+    ) -> Arc<Recorded> {
+        Arc::new(Recorded::new(self.capture_geometry(mv, to_local, f)))
+    }
+
+    /// The geometry `f` draws, in the entry space of the modelview `mv`
+    /// (`to_local` its inverse).
+    pub(super) fn capture_geometry(
+        &mut self,
+        mv: Mat4,
+        to_local: Mat4,
+        f: impl FnOnce(&mut Self),
+    ) -> Geometry {
+        self.capture = Some(Capture {
+            geometry: Geometry::default(),
+            to_local,
+            normal_to_local: Mat3::from_mat4(mv).transpose(),
+        });
+        f(self);
+        self.capture.take().map(|c| c.geometry).unwrap_or_default()
+    }
+
+    /// Adds an instance of cached geometry to the frame.
+    pub(super) fn instance(&mut self, geometry: Arc<Recorded>, mv: Mat4) {
+        if !geometry.geometry().is_empty() && self.state_only == 0 {
+            self.frame.instances.push((geometry, mv));
+        }
+    }
+
+    /// The modelview's inverse, if it has a finite one.
+    pub(super) fn to_local(mv: &Mat4) -> Option<Mat4> {
+        (mv.determinant() != 0.0).then(|| mv.inverse()).filter(|m| m.is_finite())
+    }
+}

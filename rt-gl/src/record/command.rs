@@ -1,0 +1,52 @@
+//! The calls the recorder takes, one value each: what display lists store
+//! and what [`Recorder::command`](super::Recorder::command) executes.
+
+use glam::{Mat4, Vec3, Vec4};
+
+/// One recorded call, as display lists store them.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    /// `glBegin(mode)`.
+    Begin(u32),
+    /// `glEnd`.
+    End,
+    /// `glVertex*` (missing coordinates as GL fills them: `z = 0, w = 1`).
+    Vertex(Vec4),
+    /// `glNormal*`.
+    Normal(Vec3),
+    /// `glColor*` (RGBA in `[0, 1]`).
+    Color(Vec4),
+    /// `glMatrixMode`.
+    MatrixMode(u32),
+    /// `glLoadIdentity`.
+    LoadIdentity,
+    /// `glLoadMatrix*`.
+    LoadMatrix(Mat4),
+    /// `glMultMatrix*`, and `glTranslate`/`glRotate`/`glScale`/`glFrustum`/
+    /// `glOrtho` as the matrices they multiply by.
+    MultMatrix(Mat4),
+    /// `glPushMatrix`.
+    PushMatrix,
+    /// `glPopMatrix`.
+    PopMatrix,
+    /// `glEnable(cap)`.
+    Enable(u32),
+    /// `glDisable(cap)`.
+    Disable(u32),
+    /// `glLight*(light, pname, value)` (scalars in `value[0]`).
+    Light(u32, u32, Vec4),
+    /// `glLightModel*(pname, value)`.
+    LightModel(u32, Vec4),
+    /// `glMaterial*(face, pname, value)`.
+    Material(u32, u32, Vec4),
+    /// `glColorMaterial(face, mode)`.
+    ColorMaterial(u32, u32),
+    /// `glShadeModel`.
+    ShadeModel(u32),
+    /// `glPointSize` (pixels).
+    PointSize(f32),
+    /// `glLineWidth` (pixels).
+    LineWidth(f32),
+    /// `glCallList`.
+    CallList(u32),
+}

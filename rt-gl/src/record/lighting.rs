@@ -1,0 +1,135 @@
+//! GL's lighting state: the lights, the light model, the front material,
+//! and how a primitive is shaded with them.
+
+use glam::{Vec3, Vec4};
+
+use crate::gl;
+
+/// A material's fixed-function parameters (one face).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MaterialState {
+    /// `GL_AMBIENT`.
+    pub ambient: Vec4,
+    /// `GL_DIFFUSE` (its alpha is the fragment's).
+    pub diffuse: Vec4,
+    /// `GL_SPECULAR`.
+    pub specular: Vec4,
+    /// `GL_EMISSION`.
+    pub emission: Vec4,
+    /// `GL_SHININESS`, `[0, 128]`.
+    pub shininess: f32,
+}
+
+impl Default for MaterialState {
+    fn default() -> Self {
+        Self {
+            ambient: Vec4::new(0.2, 0.2, 0.2, 1.0),
+            diffuse: Vec4::new(0.8, 0.8, 0.8, 1.0),
+            specular: Vec4::new(0.0, 0.0, 0.0, 1.0),
+            emission: Vec4::new(0.0, 0.0, 0.0, 1.0),
+            shininess: 0.0,
+        }
+    }
+}
+
+/// One of GL's eight lights, in eye space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightState {
+    /// `glEnable(GL_LIGHTi)`.
+    pub enabled: bool,
+    /// `GL_AMBIENT`.
+    pub ambient: Vec4,
+    /// `GL_DIFFUSE`.
+    pub diffuse: Vec4,
+    /// `GL_SPECULAR`.
+    pub specular: Vec4,
+    /// `GL_POSITION` in eye space (`w = 0`: a direction toward the light).
+    pub position: Vec4,
+    /// `GL_SPOT_DIRECTION` in eye space.
+    pub spot_direction: Vec3,
+    /// `GL_SPOT_EXPONENT`.
+    pub spot_exponent: f32,
+    /// `GL_SPOT_CUTOFF` in degrees (180: no spot).
+    pub spot_cutoff: f32,
+    /// Constant, linear and quadratic attenuation.
+    pub attenuation: Vec3,
+}
+
+impl LightState {
+    fn new(index: usize) -> Self {
+        // LIGHT0 is white by default; the others black.
+        let c = if index == 0 { Vec4::ONE } else { Vec4::new(0.0, 0.0, 0.0, 1.0) };
+        Self {
+            enabled: false,
+            ambient: Vec4::new(0.0, 0.0, 0.0, 1.0),
+            diffuse: c,
+            specular: c,
+            position: Vec4::new(0.0, 0.0, 1.0, 0.0),
+            spot_direction: Vec3::new(0.0, 0.0, -1.0),
+            spot_exponent: 0.0,
+            spot_cutoff: 180.0,
+            attenuation: Vec3::new(1.0, 0.0, 0.0),
+        }
+    }
+}
+
+/// Everything about lighting that is global to a frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lighting {
+    /// The eight lights.
+    pub lights: [LightState; 8],
+    /// `GL_LIGHT_MODEL_AMBIENT`.
+    pub model_ambient: Vec4,
+    /// `GL_LIGHT_MODEL_TWO_SIDE`.
+    pub two_side: bool,
+}
+
+impl Default for Lighting {
+    fn default() -> Self {
+        Self {
+            lights: core::array::from_fn(LightState::new),
+            model_ambient: Vec4::new(0.2, 0.2, 0.2, 1.0),
+            two_side: false,
+        }
+    }
+}
+
+/// How a primitive is shaded, besides its vertices' colours and normals.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shading {
+    /// `GL_LIGHTING` was on: the lighting equation; off: the colour.
+    pub lit: bool,
+    /// `glShadeModel(GL_FLAT)`: the provoking vertex's colour and normal.
+    pub flat: bool,
+    /// The front material.
+    pub material: MaterialState,
+    /// `GL_COLOR_MATERIAL` on: the parameter (`GL_AMBIENT_AND_DIFFUSE`, …)
+    /// the vertex colour stands for.
+    pub color_material: Option<u32>,
+}
+
+impl Shading {
+    /// The material at a vertex of colour `color`.
+    #[must_use]
+    pub fn material_with(&self, color: Vec4) -> MaterialState {
+        let mut m = self.material;
+        if let Some(mode) = self.color_material {
+            apply_color_material(&mut m, mode, color);
+        }
+        m
+    }
+}
+
+pub(super) fn apply_color_material(m: &mut MaterialState, mode: u32, c: Vec4) {
+    match mode {
+        gl::AMBIENT => m.ambient = c,
+        gl::DIFFUSE => m.diffuse = c,
+        gl::SPECULAR => m.specular = c,
+        gl::EMISSION => m.emission = c,
+        gl::AMBIENT_AND_DIFFUSE => {
+            m.ambient = c;
+            m.diffuse = c;
+        }
+        _ => {}
+    }
+}

@@ -1,0 +1,321 @@
+//! The recorder's state machine: matrix stacks, current attributes,
+//! lights and materials, and the dispatch of each call.
+
+use std::{collections::HashMap, sync::Arc};
+
+use glam::{Mat3, Mat4, Vec3, Vec4};
+
+use super::{
+    Command, Counters, Frame, LIST_BUDGET, Lighting, MaterialState, Recorded, Shading,
+    arrays::{ArrayState, DrawKey},
+    assemble::Vert,
+    capture::{Capture, Inherited},
+    lighting::apply_color_material,
+    lists::List,
+};
+use crate::gl;
+
+/// Deepest matrix stack kept (GL guarantees 32 modelview entries).
+pub const MAX_STACK: usize = 256;
+
+/// The fixed-function state machine; see the [module documentation](super).
+pub struct Recorder {
+    modelview: Vec<Mat4>,
+    projection: Vec<Mat4>,
+    texture: Vec<Mat4>,
+    matrix_mode: u32,
+    /// `glViewport(x, y, width, height)`.
+    pub viewport: [i32; 4],
+    /// `glClearColor`.
+    pub clear_color: Vec4,
+    pub(super) color: Vec4,
+    pub(super) normal: Vec3,
+    pub(super) point_size: f32,
+    pub(super) line_width: f32,
+    lit: bool,
+    flat: bool,
+    color_material_on: bool,
+    color_material: (u32, u32),
+    front: MaterialState,
+    /// The lights (eye space) and light model.
+    pub lighting: Lighting,
+    pub(super) lists: HashMap<u32, List>,
+    pub(super) list_base: u32,
+    /// Bumped whenever a list is defined or deleted.
+    pub(super) generation: u64,
+    pub(super) compiling: Option<(u32, u32, Vec<Command>)>,
+    pub(super) begin: Option<(u32, Vec<Vert>)>,
+    pub(super) capture: Option<Capture>,
+    /// > 0 while replaying a cached list for its state changes only.
+    pub(super) state_only: u32,
+    pub(super) depth: u32,
+    /// Commands the current top-level list call may still execute.
+    pub(super) budget: u64,
+    pub(super) list_budget: u64,
+    pub(super) cache: HashMap<u32, Vec<(Inherited, Arc<Recorded>)>>,
+    pub(super) frame: Frame,
+    /// Vertex arrays and buffer objects.
+    pub(super) arrays: ArrayState,
+    pub(super) draw_cache: HashMap<DrawKey, (Inherited, Arc<Recorded>)>,
+    /// Per draw shape ([`DrawKey::shape`]): the key of its latest entry in
+    /// `draw_cache`, whose BVHs the next recording of the shape refits.
+    pub(super) draw_shapes: HashMap<DrawKey, DrawKey>,
+    /// What has been done so far.
+    pub counters: Counters,
+}
+
+impl Default for Recorder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Recorder {
+    /// GL's initial state.
+    #[must_use]
+    pub fn new() -> Self {
+        Self {
+            modelview: vec![Mat4::IDENTITY],
+            projection: vec![Mat4::IDENTITY],
+            texture: vec![Mat4::IDENTITY],
+            matrix_mode: gl::MODELVIEW,
+            viewport: [0, 0, 0, 0],
+            clear_color: Vec4::ZERO,
+            color: Vec4::ONE,
+            normal: Vec3::Z,
+            point_size: 1.0,
+            line_width: 1.0,
+            lit: false,
+            flat: false,
+            color_material_on: false,
+            color_material: (gl::FRONT_AND_BACK, gl::AMBIENT_AND_DIFFUSE),
+            front: MaterialState::default(),
+            lighting: Lighting::default(),
+            lists: HashMap::new(),
+            list_base: 0,
+            generation: 0,
+            compiling: None,
+            begin: None,
+            capture: None,
+            state_only: 0,
+            depth: 0,
+            budget: LIST_BUDGET,
+            list_budget: LIST_BUDGET,
+            cache: HashMap::new(),
+            frame: Frame::default(),
+            arrays: ArrayState::default(),
+            draw_cache: HashMap::new(),
+            draw_shapes: HashMap::new(),
+            counters: Counters::default(),
+        }
+    }
+
+    /// The current modelview matrix.
+    #[must_use]
+    pub fn modelview(&self) -> Mat4 {
+        *self.modelview.last().unwrap_or(&Mat4::IDENTITY)
+    }
+
+    /// The current projection matrix.
+    #[must_use]
+    pub fn projection(&self) -> Mat4 {
+        *self.projection.last().unwrap_or(&Mat4::IDENTITY)
+    }
+
+    /// The frame drawn so far.
+    #[must_use]
+    pub fn frame(&self) -> &Frame {
+        &self.frame
+    }
+
+    /// Whether a display list is being compiled with `GL_COMPILE` (calls
+    /// are stored, not executed).
+    #[must_use]
+    pub fn compiling_only(&self) -> bool {
+        matches!(self.compiling, Some((_, gl::COMPILE, _)))
+    }
+
+    /// Ends the frame: returns what was drawn and starts an empty one.
+    pub fn end_frame(&mut self) -> Frame {
+        self.counters.frames += 1;
+        self.counters.instances = self.frame.instances.len() as u64;
+        self.counters.triangles = (self.frame.immediate.triangles.len()
+            + self.frame.instances.iter().map(|(r, _)| r.geometry().triangles.len()).sum::<usize>())
+            as u64;
+        core::mem::take(&mut self.frame)
+    }
+
+    /// `glClear(mask)`: clearing the colour buffer starts the frame over.
+    pub fn clear(&mut self, mask: u32) {
+        if mask & gl::COLOR_BUFFER_BIT != 0 && !self.compiling_only() {
+            self.frame = Frame::default();
+        }
+    }
+
+    /// Records or executes one call, as GL would in the current list mode.
+    pub fn command(&mut self, c: Command) {
+        if let Some((_, mode, commands)) = &mut self.compiling {
+            commands.push(c.clone());
+            if *mode == gl::COMPILE {
+                return;
+            }
+        }
+        self.execute(&c);
+    }
+
+    fn stack(&mut self) -> &mut Vec<Mat4> {
+        match self.matrix_mode {
+            gl::PROJECTION => &mut self.projection,
+            gl::TEXTURE => &mut self.texture,
+            _ => &mut self.modelview,
+        }
+    }
+
+    fn top(&mut self) -> &mut Mat4 {
+        let s = self.stack();
+        if s.is_empty() {
+            s.push(Mat4::IDENTITY);
+        }
+        s.last_mut().expect("non-empty")
+    }
+
+    pub(super) fn shading(&self) -> Shading {
+        Shading {
+            lit: self.lit,
+            flat: self.flat,
+            material: self.front,
+            color_material: self.color_material_on.then_some(self.color_material.1),
+        }
+    }
+
+    pub(super) fn execute(&mut self, c: &Command) {
+        match *c {
+            Command::Begin(mode) => {
+                if self.begin.is_some() || mode > gl::POLYGON {
+                    self.counters.ignored += 1;
+                } else {
+                    self.begin = Some((mode, Vec::new()));
+                }
+            }
+            Command::End => match self.begin.take() {
+                Some((mode, verts)) => {
+                    if self.state_only == 0 {
+                        self.assemble(mode, &verts);
+                    }
+                }
+                None => self.counters.ignored += 1,
+            },
+            Command::Vertex(v) => self.vertex(v),
+            Command::Normal(n) => self.normal = n,
+            Command::Color(col) => {
+                self.color = col;
+                if self.color_material_on {
+                    apply_color_material(&mut self.front, self.color_material.1, col);
+                }
+            }
+            Command::MatrixMode(m) => {
+                if matches!(m, gl::MODELVIEW | gl::PROJECTION | gl::TEXTURE) {
+                    self.matrix_mode = m;
+                } else {
+                    self.counters.ignored += 1;
+                }
+            }
+            Command::LoadIdentity => *self.top() = Mat4::IDENTITY,
+            Command::LoadMatrix(m) => *self.top() = m,
+            Command::MultMatrix(m) => {
+                *self.top() *= m;
+            }
+            Command::PushMatrix => {
+                let s = self.stack();
+                match s.last().copied() {
+                    Some(top) if s.len() < MAX_STACK => s.push(top),
+                    _ => self.counters.ignored += 1,
+                }
+            }
+            Command::PopMatrix => {
+                let s = self.stack();
+                if s.len() > 1 {
+                    s.pop();
+                } else {
+                    self.counters.ignored += 1;
+                }
+            }
+            Command::Enable(cap) => self.set_cap(cap, true),
+            Command::Disable(cap) => self.set_cap(cap, false),
+            Command::Light(light, pname, v) => self.light(light, pname, v),
+            Command::LightModel(pname, v) => match pname {
+                gl::LIGHT_MODEL_AMBIENT => self.lighting.model_ambient = v,
+                gl::LIGHT_MODEL_TWO_SIDE => self.lighting.two_side = v.x != 0.0,
+                _ => {}
+            },
+            Command::Material(face, pname, v) => {
+                // Back materials are not kept: one-sided lighting, and
+                // two-sided lighting with the front material on both sides.
+                if face == gl::FRONT || face == gl::FRONT_AND_BACK {
+                    let m = &mut self.front;
+                    match pname {
+                        gl::SHININESS => m.shininess = v.x.clamp(0.0, 128.0),
+                        mode => apply_color_material(m, mode, v),
+                    }
+                }
+            }
+            Command::ColorMaterial(face, mode) => {
+                self.color_material = (face, mode);
+                if self.color_material_on {
+                    apply_color_material(&mut self.front, mode, self.color);
+                }
+            }
+            Command::ShadeModel(m) => self.flat = m == gl::FLAT,
+            Command::PointSize(s) => {
+                if s > 0.0 && s.is_finite() {
+                    self.point_size = s;
+                }
+            }
+            Command::LineWidth(w) => {
+                if w > 0.0 && w.is_finite() {
+                    self.line_width = w;
+                }
+            }
+            Command::CallList(id) => self.call_list(id),
+        }
+    }
+
+    fn set_cap(&mut self, cap: u32, on: bool) {
+        match cap {
+            gl::LIGHTING => self.lit = on,
+            gl::COLOR_MATERIAL => {
+                self.color_material_on = on;
+                if on {
+                    apply_color_material(&mut self.front, self.color_material.1, self.color);
+                }
+            }
+            c if (gl::LIGHT0..gl::LIGHT0 + 8).contains(&c) => {
+                self.lighting.lights[(c - gl::LIGHT0) as usize].enabled = on;
+            }
+            _ => {}
+        }
+    }
+
+    fn light(&mut self, light: u32, pname: u32, v: Vec4) {
+        let Some(i) = light.checked_sub(gl::LIGHT0).filter(|&i| i < 8) else {
+            self.counters.ignored += 1;
+            return;
+        };
+        let mv = self.modelview();
+        let l = &mut self.lighting.lights[i as usize];
+        match pname {
+            gl::AMBIENT => l.ambient = v,
+            gl::DIFFUSE => l.diffuse = v,
+            gl::SPECULAR => l.specular = v,
+            // Positions and directions are kept in eye space, as GL does.
+            gl::POSITION => l.position = mv * v,
+            gl::SPOT_DIRECTION => l.spot_direction = Mat3::from_mat4(mv) * v.truncate(),
+            gl::SPOT_EXPONENT => l.spot_exponent = v.x,
+            gl::SPOT_CUTOFF => l.spot_cutoff = v.x,
+            gl::CONSTANT_ATTENUATION => l.attenuation.x = v.x,
+            gl::LINEAR_ATTENUATION => l.attenuation.y = v.x,
+            gl::QUADRATIC_ATTENUATION => l.attenuation.z = v.x,
+            _ => {}
+        }
+    }
+}
