@@ -53,7 +53,7 @@ pub mod record;
 pub mod render;
 
 use record::Recorder;
-use render::{Mode, Options};
+use render::{Illumination, Options};
 
 /// The settings read from the environment.
 #[derive(Debug)]
@@ -88,8 +88,8 @@ impl Config {
             }
         };
         match var("RT_GL_MODE").as_deref() {
-            None | Some("gl") => options.mode = Mode::Gl,
-            Some("rt") => options.mode = Mode::Rt,
+            None | Some("gl") => options.mode = Illumination::Gl,
+            Some("rt") => options.mode = Illumination::Rt,
             Some(v) => {
                 log_once("RT_GL_MODE", &format!("RT_GL_MODE={v}: expected gl or rt; using gl"))
             }

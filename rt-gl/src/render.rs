@@ -1,7 +1,7 @@
 //! Ray tracing a recorded frame: one ray per pixel through the program's
 //! own projection, shaded with the fixed-function lighting equation
 //! (OpenGL 2.1 specification §2.14.1) evaluated per pixel; in
-//! [`Mode::Rt`] with shadow rays toward every light, ambient occlusion on
+//! [`Illumination::Rt`] with shadow rays toward every light, ambient occlusion on
 //! the ambient terms and mirror reflections weighted by the specular
 //! colour.
 //!
@@ -21,11 +21,13 @@ use rt_core::{
     Hit, PrimKind, Ray, SceneQuery, camera::cosine_hemisphere, sampling, spawn_ray, spawn_ray_to,
 };
 
-use crate::record::{Frame, Geometry, GeometryError, Lighting, Recorded, Shading, normal_matrix};
+use crate::record::{
+    FrameDraws, Geometry, GeometryError, Lighting, Recorded, Shading, normal_matrix,
+};
 
-/// How frames are shaded.
+/// How frames are lit: GL's fixed-function model, or ray-traced.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Mode {
+pub enum Illumination {
     /// The fixed-function lighting model, per pixel: comparable with the
     /// program's own image.
     Gl,
@@ -44,7 +46,7 @@ pub const MAX_AO_SAMPLES: u32 = 1024;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Options {
     /// Shading mode.
-    pub mode: Mode,
+    pub mode: Illumination,
     /// Shadow rays toward every enabled light (`Rt` mode).
     pub shadows: bool,
     /// Ambient-occlusion rays per pixel (`Rt` mode; 0: off), at most
@@ -75,7 +77,7 @@ impl Options {
 impl Default for Options {
     fn default() -> Self {
         Self {
-            mode: Mode::Gl,
+            mode: Illumination::Gl,
             shadows: true,
             ao_samples: 8,
             ao_distance: 0.2,
@@ -206,7 +208,7 @@ impl FrameScene {
     /// [`RenderError::Geometry`] if a geometry is malformed
     /// ([`Geometry::check`]) or a primitive is not finite;
     /// [`RenderError::Instance`] if a transform is singular.
-    pub fn build(frame: Frame) -> Result<Self, RenderError> {
+    pub fn build(frame: FrameDraws) -> Result<Self, RenderError> {
         let scene = frame.immediate.build()?;
         let mut objects: Vec<Arc<Recorded>> = Vec::new();
         let mut placements = Vec::with_capacity(frame.instances.len());
@@ -368,7 +370,7 @@ impl FrameScene {
         }
         let geo_n = if back { -hit.normal } else { hit.normal };
         let m = sh.material_with(color);
-        let rt = opts.mode == Mode::Rt;
+        let rt = opts.mode == Illumination::Rt;
         let ambient_visibility = if rt && depth == 0 && opts.ao_samples > 0 && self.diagonal > 0.0 {
             self.ambient_visibility(hit, geo_n, opts, seed)
         } else {

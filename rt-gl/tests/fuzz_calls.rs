@@ -7,7 +7,7 @@ use rt_core::glam::{Mat4, Vec3, Vec4};
 use rt_gl::{
     gl,
     record::{Command, GeometryError, Recorder, arrays},
-    render::{FrameScene, Mode, Options, RenderError},
+    render::{FrameScene, Illumination, Options, RenderError},
 };
 
 /// Floats including the awkward ones.
@@ -99,7 +99,7 @@ fn step() -> impl Strategy<Value = Step> {
     ]
 }
 
-fn trace(r: &Recorder, mode: Mode) {
+fn trace(r: &Recorder, mode: Illumination) {
     let frame = r.frame().clone();
     // What the recorder makes is always well formed.
     assert_eq!(frame.immediate.check(), Ok(()));
@@ -135,7 +135,7 @@ proptest! {
         // budget keeps each case short (the default bounds them too).
         r.set_list_budget(20_000);
         r.viewport = [0, 0, 12, 9];
-        let mode = if rt { Mode::Rt } else { Mode::Gl };
+        let mode = if rt { Illumination::Rt } else { Illumination::Gl };
         for s in steps {
             match s {
                 Step::Call(c) => r.command(c),

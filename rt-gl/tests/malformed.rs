@@ -14,10 +14,10 @@ use rt_accel::BuildError;
 use rt_core::glam::{Mat4, Vec3, Vec4};
 use rt_gl::{
     record::{
-        Command, Frame, Geometry, GeometryError, Lighting, MaterialState, Primitive, Recorded,
+        Command, FrameDraws, Geometry, GeometryError, Lighting, MaterialState, Primitive, Recorded,
         Recorder, Shading, frustum, translate,
     },
-    render::{FrameScene, Image, MAX_AO_SAMPLES, MAX_BOUNCES, Mode, Options, RenderError},
+    render::{FrameScene, Illumination, Image, MAX_AO_SAMPLES, MAX_BOUNCES, Options, RenderError},
 };
 
 const SIZE: u32 = 32;
@@ -63,19 +63,19 @@ fn pixel_of(p: Vec3) -> (u32, u32) {
     (px(ndc.x), px(ndc.y))
 }
 
-fn render(frame: Frame, opts: &Options) -> Result<Image, RenderError> {
+fn render(frame: FrameDraws, opts: &Options) -> Result<Image, RenderError> {
     let scene = FrameScene::build(frame)?;
     scene.render(&Lighting::default(), projection(), SIZE, SIZE, Vec4::ZERO, opts)
 }
 
-fn immediate(g: Geometry) -> Frame {
-    Frame { immediate: g, instances: Vec::new() }
+fn immediate(g: Geometry) -> FrameDraws {
+    FrameDraws { immediate: g, instances: Vec::new() }
 }
 
 /// `g` as one recording, placed twice (once moved aside).
-fn instanced(g: Geometry) -> Frame {
+fn instanced(g: Geometry) -> FrameDraws {
     let rec = Arc::new(Recorded::new(g));
-    Frame {
+    FrameDraws {
         immediate: Geometry::default(),
         instances: vec![
             (Arc::clone(&rec), Mat4::IDENTITY),
@@ -190,7 +190,7 @@ fn well_formed_geometry_renders() {
 /// structural rules only), [`Geometry::build`], [`Recorded::scene`] (built
 /// and refitted from a good recording), [`FrameScene::build`] (as the
 /// frame's immediate geometry or as a recording),
-/// [`Geometry::append_transformed`] and [`Frame::flatten`], never a
+/// [`Geometry::append_transformed`] and [`FrameDraws::flatten`], never a
 /// panic.
 #[test]
 fn malformed_geometry_is_refused_everywhere() {
@@ -264,7 +264,7 @@ fn hall_of_mirrors() -> Geometry {
 /// it (an abort, not even a panic); [`MAX_BOUNCES`] itself renders.
 #[test]
 fn options_out_of_range_are_refused() {
-    let base = Options { mode: Mode::Rt, ao_samples: 2, mirror: 0.5, ..Options::default() };
+    let base = Options { mode: Illumination::Rt, ao_samples: 2, mirror: 0.5, ..Options::default() };
     let bad = [
         Options { bounces: MAX_BOUNCES + 1, ..base },
         Options { bounces: u32::MAX, ..base },

@@ -5,7 +5,7 @@ use rt_core::glam::{Mat4, Vec3, Vec4};
 use rt_gl::{
     gl,
     record::{Command, Recorder, arrays, frustum, ortho, rotate, translate},
-    render::{FrameScene, Mode, Options, RenderError},
+    render::{FrameScene, Illumination, Options, RenderError},
 };
 
 fn draw(r: &mut Recorder, mode: u32, verts: &[Vec3]) {
@@ -323,16 +323,16 @@ fn rt_mode_adds_shadows_deterministically() {
             scene.render(&r.lighting, r.projection(), 48, 48, Vec4::ZERO, &opts).unwrap()
         })
     };
-    let gl_img = render(Mode::Gl, 1);
-    let rt1 = render(Mode::Rt, 1);
-    assert_eq!(rt1, render(Mode::Rt, 3));
+    let gl_img = render(Illumination::Gl, 1);
+    let rt1 = render(Illumination::Rt, 1);
+    assert_eq!(rt1, render(Illumination::Rt, 3));
     // Light straight down the view: the card's shadow hides behind the
     // card, so both modes show the same card.
     assert_eq!(rt1.get(24, 24), gl_img.get(24, 24));
     // Tilt the light: the shadow moves out from under the card.
     let mut tilted = r.lighting.clone();
     tilted.lights[0].position = Vec4::new(1.0, 0.0, 1.0, 0.0);
-    let opts = Options { mode: Mode::Rt, ao_samples: 0, ..Options::default() };
+    let opts = Options { mode: Illumination::Rt, ao_samples: 0, ..Options::default() };
     let shadowed = scene.render(&tilted, r.projection(), 48, 48, Vec4::ZERO, &opts).unwrap();
     let plain =
         scene.render(&tilted, r.projection(), 48, 48, Vec4::ZERO, &Options::default()).unwrap();
@@ -385,7 +385,7 @@ fn settings_fall_back_on_unreadable_values() {
         ("RT_GL_SHADOWS", "0"),
         ("RT_GL_THREADS", "2"),
     ]);
-    assert_eq!(good.options.mode, Mode::Rt);
+    assert_eq!(good.options.mode, Illumination::Rt);
     assert_eq!((good.options.ao_samples, good.options.shadows), (32, false));
     assert_eq!(good.pool.as_ref().map(rayon::ThreadPool::current_num_threads), Some(2));
     let bad = cfg(&[
@@ -427,8 +427,8 @@ fn rt_mode_mirrors_specular_surfaces() {
         scene.render(&r.lighting, r.projection(), 16, 16, sky, &opts).unwrap()
     };
     // 0.2·0.2 ambient + 0.2·1 diffuse = 0.24 → 61; plus 0.5 · 1 · sky.
-    assert_eq!(render(Mode::Gl).get(8, 8), Some([61, 61, 61, 255]));
-    assert_eq!(render(Mode::Rt).get(8, 8), Some([61, 61, 189, 255]));
+    assert_eq!(render(Illumination::Gl).get(8, 8), Some([61, 61, 61, 255]));
+    assert_eq!(render(Illumination::Rt).get(8, 8), Some([61, 61, 189, 255]));
 }
 
 /// Lists that call each other twice over ask for 2⁶⁴ commands within

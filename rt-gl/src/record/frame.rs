@@ -9,14 +9,14 @@ use super::{Geometry, GeometryError, Recorded};
 /// One frame's draws: immediate geometry in eye space and instances of
 /// cached display lists.
 #[derive(Clone, Debug, Default)]
-pub struct Frame {
+pub struct FrameDraws {
     /// Immediate-mode geometry, eye space.
     pub immediate: Geometry,
     /// Cached list geometry and the modelview of each call.
     pub instances: Vec<(Arc<Recorded>, Mat4)>,
 }
 
-impl Frame {
+impl FrameDraws {
     /// Whether nothing was drawn.
     #[must_use]
     pub fn is_empty(&self) -> bool {

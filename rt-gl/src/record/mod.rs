@@ -27,7 +27,7 @@
 //! - [`arrays`]: vertex arrays and buffer objects.
 //! - `geometry.rs`: [`Geometry`] and its BVHs; `check.rs`: its checks.
 //! - `recorded.rs`: [`Recorded`], cached geometry and its BVHs.
-//! - `frame.rs`: [`Frame`]; `counters.rs`: [`Counters`].
+//! - `frame.rs`: [`FrameDraws`]; `counters.rs`: [`Counters`].
 //! - `matrix.rs`: the matrices of GL's matrix calls.
 
 pub mod arrays;
@@ -48,7 +48,7 @@ pub use arrays::ArrayPointer;
 pub use check::{GeometryError, Primitive};
 pub use command::Command;
 pub use counters::Counters;
-pub use frame::Frame;
+pub use frame::FrameDraws;
 pub use geometry::Geometry;
 pub use lighting::{LightState, Lighting, MaterialState, Shading};
 pub use lists::{LIST_BUDGET, MAX_LIST_NESTING};

@@ -6,7 +6,7 @@ use std::{collections::HashMap, sync::Arc};
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use super::{
-    Command, Counters, Frame, LIST_BUDGET, Lighting, MaterialState, Recorded, Shading,
+    Command, Counters, FrameDraws, LIST_BUDGET, Lighting, MaterialState, Recorded, Shading,
     arrays::{ArrayState, DrawKey},
     assemble::Vert,
     capture::{Capture, Inherited},
@@ -53,7 +53,7 @@ pub struct Recorder {
     pub(super) budget: u64,
     pub(super) list_budget: u64,
     pub(super) cache: HashMap<u32, Vec<(Inherited, Arc<Recorded>)>>,
-    pub(super) frame: Frame,
+    pub(super) frame: FrameDraws,
     /// Vertex arrays and buffer objects.
     pub(super) arrays: ArrayState,
     pub(super) draw_cache: HashMap<DrawKey, (Inherited, Arc<Recorded>)>,
@@ -102,7 +102,7 @@ impl Recorder {
             budget: LIST_BUDGET,
             list_budget: LIST_BUDGET,
             cache: HashMap::new(),
-            frame: Frame::default(),
+            frame: FrameDraws::default(),
             arrays: ArrayState::default(),
             draw_cache: HashMap::new(),
             draw_shapes: HashMap::new(),
@@ -124,7 +124,7 @@ impl Recorder {
 
     /// The frame drawn so far.
     #[must_use]
-    pub fn frame(&self) -> &Frame {
+    pub fn frame(&self) -> &FrameDraws {
         &self.frame
     }
 
@@ -136,7 +136,7 @@ impl Recorder {
     }
 
     /// Ends the frame: returns what was drawn and starts an empty one.
-    pub fn end_frame(&mut self) -> Frame {
+    pub fn end_frame(&mut self) -> FrameDraws {
         self.counters.frames += 1;
         self.counters.instances = self.frame.instances.len() as u64;
         self.counters.triangles = (self.frame.immediate.triangles.len()
@@ -148,7 +148,7 @@ impl Recorder {
     /// `glClear(mask)`: clearing the colour buffer starts the frame over.
     pub fn clear(&mut self, mask: u32) {
         if mask & gl::COLOR_BUFFER_BIT != 0 && !self.compiling_only() {
-            self.frame = Frame::default();
+            self.frame = FrameDraws::default();
         }
     }
 
