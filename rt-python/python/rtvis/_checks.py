@@ -1,0 +1,80 @@
+"""The argument checkers every entry point runs before the native half:
+``TypeError`` for the wrong kind of value, ``ValueError`` for the wrong
+shape, NaN, out of range or an unknown option."""
+
+from __future__ import annotations
+
+import math
+from typing import Optional, Sequence, Tuple
+
+import numpy as np
+
+
+def _choice(name: str, value, known: Sequence[str]) -> str:
+    if not isinstance(value, str):
+        raise TypeError(f"{name}: expected one of {', '.join(known)} (a str), got {type(value).__name__}")
+    if value not in known:
+        raise ValueError(f"{name}: unknown {value!r} (known: {', '.join(known)})")
+    return value
+
+
+def _number(name: str, value, *, positive: bool = False, optional: bool = False) -> Optional[float]:
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name}: expected a number, got {type(value).__name__}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite (got {v})")
+    if positive and v <= 0.0:
+        raise ValueError(f"{name} must be > 0 (got {v})")
+    return v
+
+
+def _integer(name: str, value, lo: int, hi: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name}: expected an int, got {type(value).__name__}")
+    v = int(value)
+    if not lo <= v <= hi:
+        raise ValueError(f"{name} must be {lo} to {hi} (got {v})")
+    return v
+
+
+def _vector(name: str, value, n: int = 3) -> Tuple[float, ...]:
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name}: expected {n} numbers") from None
+    if a.shape != (n,):
+        raise ValueError(f"{name}: expected {n} numbers, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be finite (got {tuple(a)})")
+    return tuple(float(v) for v in a)
+
+
+def _array(name: str, value, ndim: int, dtype, *, last: Optional[int] = None, integer: bool = False) -> np.ndarray:
+    """``value`` as a C-contiguous array of ``dtype`` (copied if needed),
+    its kind and shape checked."""
+    if not isinstance(value, np.ndarray):
+        try:
+            value = np.asarray(value)
+        except (TypeError, ValueError):
+            raise TypeError(f"{name}: expected an array of numbers") from None
+    kinds = "iu" if integer else "fiu"
+    if value.dtype.kind not in kinds:
+        what = "integers" if integer else "float32 or float64 numbers"
+        raise TypeError(f"{name}: expected {what}, got dtype {value.dtype}")
+    if value.ndim != ndim or (last is not None and value.shape[-1] != last):
+        want = f"{ndim} dimensions" + (f", the last of length {last}" if last is not None else "")
+        raise ValueError(f"{name}: expected {want}; got shape {value.shape}")
+    if value.size == 0:
+        raise ValueError(f"{name} is empty (shape {value.shape})")
+    if integer:
+        return np.ascontiguousarray(value, dtype=np.int64)
+    with np.errstate(over="ignore", invalid="ignore"):  # reported below
+        out = np.ascontiguousarray(value, dtype=dtype)
+    bad = ~np.isfinite(out)
+    if bad.any():
+        where = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise ValueError(f"{name}: value at {where} is not finite ({out[where]})")
+    return out

@@ -1,0 +1,251 @@
+"""What the optics look through: ``Volume`` (a gridded array, or
+``read_volume``'s file) and ``Mesh`` (an unstructured CFD mesh, or
+``read_mesh``'s file)."""
+
+from __future__ import annotations
+
+from typing import Optional, Tuple
+
+import numpy as np
+
+from . import _rtvis
+from ._checks import _array, _choice, _number, _vector
+
+
+#: Gladstone–Dale constant of air at 589 nm, m³/kg (``n = 1 + K·ρ``).
+GLADSTONE_DALE_AIR: float = _rtvis.GLADSTONE_DALE_AIR
+
+_QUANTITIES = ("density", "index")
+_INTERPOLATIONS = ("linear", "cubic")
+
+
+class Volume:
+    """A gridded volume of density or refractive index, ready for the
+    optical bench.
+
+    Parameters
+    ----------
+    values : ndarray, shape (nz, ny, nx), float32 or float64
+        Samples, ``values[k, j, i]`` at ``origin + (i·dx, j·dy, k·dz)``
+        (x varies fastest, as VTK and NRRD store it). Any strides; copied.
+        Stored as float32.
+    spacing : 3 numbers, default (1, 1, 1)
+        Sample spacing ``(dx, dy, dz)``, > 0, in metres (or your unit).
+    origin : 3 numbers, default (0, 0, 0)
+        Centre of sample ``[0, 0, 0]``.
+    quantity : "density" or "index"
+        ``density`` (kg/m³) is mapped to refractive index by
+        Gladstone–Dale ``n = 1 + k·ρ``; ``index`` is used as is.
+    k : float
+        Gladstone–Dale constant in m³/kg (air at 589 nm by default).
+    interpolation : "cubic" or "linear"
+        Catmull–Rom tricubic (the default; C¹: smooth shadowgraphs), or
+        trilinear (about twice as fast; its gradient jumps at cell faces,
+        so shadowgraphs show the grid).
+    allow_nonphysical : bool
+        Accept densities ≤ 0 or indices below 1.
+
+    The index outside the volume is that of sample ``[0, 0, 0]``.
+    """
+
+    def __init__(
+        self,
+        values,
+        spacing=(1.0, 1.0, 1.0),
+        origin=(0.0, 0.0, 0.0),
+        quantity: str = "density",
+        k: float = GLADSTONE_DALE_AIR,
+        interpolation: str = "cubic",
+        allow_nonphysical: bool = False,
+    ):
+        arr = _array("values", values, 3, np.float32)
+        self._v = _rtvis._Volume(
+            arr,
+            _vector("spacing", spacing),
+            _vector("origin", origin),
+            _choice("quantity", quantity, _QUANTITIES),
+            _number("k", k, positive=True),
+            _choice("interpolation", interpolation, _INTERPOLATIONS),
+            bool(allow_nonphysical),
+        )
+
+    @classmethod
+    def _wrap(cls, native) -> "Volume":
+        v = cls.__new__(cls)
+        v._v = native
+        return v
+
+    @property
+    def shape(self) -> Tuple[int, int, int]:
+        """Samples per axis, ``(nz, ny, nx)``."""
+        return tuple(self._v.shape)
+
+    @property
+    def spacing(self) -> Tuple[float, float, float]:
+        """Sample spacing ``(dx, dy, dz)``."""
+        return tuple(self._v.spacing)
+
+    @property
+    def origin(self) -> Tuple[float, float, float]:
+        """Centre of sample ``[0, 0, 0]``, ``(x, y, z)``."""
+        return tuple(self._v.origin)
+
+    @property
+    def bounds(self):
+        """``((xmin, ymin, zmin), (xmax, ymax, zmax))``: the box the
+        samples span."""
+        lo, hi = self._v.bounds
+        return tuple(lo), tuple(hi)
+
+    def index(self) -> np.ndarray:
+        """The refractive index samples, float32 ``[z, y, x]``."""
+        return self._v.index()
+
+    def __repr__(self) -> str:
+        return f"rtvis.Volume(shape={self.shape}, spacing={self.spacing}, origin={self.origin})"
+
+
+def read_volume(
+    path,
+    quantity: str = "density",
+    k: float = GLADSTONE_DALE_AIR,
+    interpolation: str = "cubic",
+    allow_nonphysical: bool = False,
+) -> Volume:
+    """Reads a volume file: NRRD (``.nrrd``/``.nhdr``), raw + JSON sidecar
+    (``.json``) or VTK image data (``.vtk``/``.vti``).
+
+    ``quantity``, ``k``, ``interpolation`` and ``allow_nonphysical`` as for
+    :class:`Volume`. Raises ``OSError`` if the file cannot be read and
+    ``ValueError`` if it is malformed or holds no usable grid.
+    """
+    import os
+
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path: expected a str or path, got {type(path).__name__}")
+    native = _rtvis._read_volume(
+        os.fspath(path),
+        _choice("quantity", quantity, _QUANTITIES),
+        _number("k", k, positive=True),
+        _choice("interpolation", interpolation, _INTERPOLATIONS),
+        bool(allow_nonphysical),
+    )
+    return Volume._wrap(native)
+
+
+_MESH_KINDS = {"tetra": 4, "pyramid": 5, "wedge": 6, "hexahedron": 8}
+_TRACES = ("exact", "smooth")
+_SURFACE_KINDS = {"vertex", "line", "line3", "triangle", "triangle6", "quad", "quad8", "quad9", "polygon"}
+
+
+class Mesh:
+    """An unstructured CFD mesh (tetrahedra, pyramids, wedges, hexahedra)
+    with one value per point, ready for the optical bench.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 3)
+        Point coordinates.
+    cells : dict
+        Cells by kind, meshio's names and VTK's point order: ``"tetra"``
+        ``(m, 4)``, ``"pyramid"`` ``(m, 5)``, ``"wedge"`` ``(m, 6)``,
+        ``"hexahedron"`` ``(m, 8)`` integer arrays of point indices
+        (``meshio.Mesh.cells_dict`` fits: its vertices, lines, triangles
+        and quads are skipped, other kinds raise ``ValueError``).
+    values : array_like, shape (n,)
+        Density (kg/m³) or refractive index at each point.
+    quantity, k, allow_nonphysical
+        As for :class:`Volume`.
+    trace : "smooth" or "exact"
+        ``smooth`` (the default: it reaches a given error sooner): gradients
+        recovered at the points and integrated (second order per ray, no
+        facets on coarse meshes); ``exact``: through the data's
+        piecewise-linear interpolant, cell by cell in closed form (first
+        order per ray).
+
+    Cells are split into tetrahedra about their face and cell centres (24
+    per hexahedron; no preferred direction; neighbours meet face to face); bad
+    meshes (NaN, zero-volume or inverted cells, indices out of range, a
+    face shared by three cells) raise ``ValueError`` naming the cell. The
+    index outside the mesh is that of its first point.
+    """
+
+    def __init__(self, points, cells, values, quantity: str = "density",
+                 k: float = GLADSTONE_DALE_AIR, trace: str = "smooth",
+                 allow_nonphysical: bool = False):
+        pts = _array("points", points, 2, np.float64, last=3)
+        vals = _array("values", values, 1, np.float64)
+        if not isinstance(cells, dict):
+            raise TypeError(f"cells: expected a dict of kind → array, got {type(cells).__name__}")
+        by_kind = {}
+        for kind, arr in cells.items():
+            if kind in _SURFACE_KINDS or np.asarray(arr).size == 0:
+                continue  # no volume (meshio lists boundary patches too)
+            if kind not in _MESH_KINDS:
+                raise ValueError(f"cells: unknown kind {kind!r} (known: {', '.join(_MESH_KINDS)})")
+            by_kind[kind] = _array(f"cells[{kind!r}]", arr, 2, np.int64, last=_MESH_KINDS[kind], integer=True)
+        empty = {kind: np.zeros((0, width), np.int64) for kind, width in _MESH_KINDS.items()}
+        empty.update(by_kind)
+        self._v = _rtvis._Volume.mesh(
+            pts, empty["tetra"], empty["pyramid"], empty["wedge"], empty["hexahedron"], vals,
+            _choice("quantity", quantity, _QUANTITIES),
+            _number("k", k, positive=True),
+            _choice("trace", trace, _TRACES),
+            bool(allow_nonphysical),
+        )
+
+    @classmethod
+    def _wrap(cls, native) -> "Mesh":
+        m = cls.__new__(cls)
+        m._v = native
+        return m
+
+    @property
+    def bounds(self):
+        """``((xmin, ymin, zmin), (xmax, ymax, zmax))``: the box around the
+        points."""
+        lo, hi = self._v.bounds
+        return tuple(lo), tuple(hi)
+
+    @property
+    def counts(self) -> Tuple[int, int, int, int]:
+        """``(points, cells, tetrahedra, boundary faces)``."""
+        return tuple(self._v.mesh_counts)
+
+    def __repr__(self) -> str:
+        p, c, t, _ = self.counts
+        return f"rtvis.Mesh(points={p}, cells={c}, tetrahedra={t})"
+
+
+def read_mesh(
+    path,
+    array: Optional[str] = None,
+    quantity: str = "density",
+    k: float = GLADSTONE_DALE_AIR,
+    trace: str = "smooth",
+    allow_nonphysical: bool = False,
+) -> Mesh:
+    """Reads an unstructured mesh: VTK XML ``.vtu`` or legacy ``.vtk``
+    (``UNSTRUCTURED_GRID``), tetrahedra, pyramids, wedges, hexahedra and
+    voxels (lower-dimensional cells are skipped).
+
+    ``array`` names the point- or cell-data array (default: the first
+    scalar point array, else the first scalar cell array, averaged to the
+    points); the others as for :class:`Mesh`. Raises ``OSError`` if the
+    file cannot be read and ``ValueError`` if it is malformed.
+    """
+    import os
+
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path: expected a str or path, got {type(path).__name__}")
+    if array is not None and not isinstance(array, str):
+        raise TypeError(f"array: expected a str, got {type(array).__name__}")
+    native = _rtvis._read_mesh(
+        os.fspath(path),
+        array,
+        _choice("quantity", quantity, _QUANTITIES),
+        _number("k", k, positive=True),
+        _choice("trace", trace, _TRACES),
+        bool(allow_nonphysical),
+    )
+    return Mesh._wrap(native)
