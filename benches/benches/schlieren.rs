@@ -9,11 +9,11 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rt_benches::scenes::{knife_bench, sparse_bumps};
 use rt_photo::{Film, Filter};
-use rt_volume::{Method, TraceParams, build_octree, trace};
+use rt_photo::{GridMedium, Medium};
+use rt_volume::{Method, TraceParams, trace};
 
 fn schlieren(c: &mut Criterion) {
     let f = sparse_bumps();
-    let tree = build_octree(&f).expect("octree");
     let h = f.grid().spacing().x;
     let rt = TraceParams::for_grid(&f);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
@@ -25,6 +25,7 @@ fn schlieren(c: &mut Criterion) {
         ("rt-2voxel", TraceParams { step: 2.0 * h, max_step: 2.0 * h, ..rt }),
     ] {
         let b = knife_bench(params, 1);
+        let medium = Medium::Grid(GridMedium::from_field(f.clone(), params).expect("octree"));
         g.bench_function(name, |bn| {
             bn.iter(|| {
                 let mut film = Film::new(128, 128, Filter::Box).expect("film");
@@ -32,7 +33,7 @@ fn schlieren(c: &mut Criterion) {
                     if name == "original" {
                         b.render_with(&|o, d| trace(&f, o, d, &b.params), &mut film, 0, 7)
                     } else {
-                        b.render_grid(&f, &tree, &mut film, 0, 7)
+                        b.render_medium(&medium, &mut film, 0, 7)
                     }
                 })
                 .expect("render");

@@ -9,7 +9,7 @@
 //! - `moving_mesh`: vertices moved, the BVH refitted against rebuilt;
 //! - `volume`: 128² photons through the sparse 128³ bump field, marched
 //!   everywhere (`trace`), skipping uniform octree nodes
-//!   (`trace_skipping`), and with the beam mask (`render_grid`).
+//!   (`trace_skipping`), and with the beam mask (`render_medium` on a grid).
 // A std-only tool crate: the no_std import lints guard the libraries.
 #![allow(clippy::std_instead_of_core, clippy::std_instead_of_alloc, clippy::alloc_instead_of_core)]
 // criterion_group! generates undocumented items.
@@ -26,6 +26,7 @@ use rt_accel::{BuildParams, TriangleMesh};
 use rt_benches::scenes::{self, knife_bench, sparse_bumps};
 use rt_core::{Camera, Projection, SceneQuery, intersect::Sphere};
 use rt_photo::{Film, Filter};
+use rt_photo::{GridMedium, Medium};
 use rt_surface::{Glyphs, Light, Material, Paint, Renderer, Settings, SurfaceScene};
 use rt_volume::{TraceParams, build_octree, trace, trace_skipping};
 
@@ -167,8 +168,9 @@ fn skips(c: &mut Criterion) {
                 })
             })
         });
+        let medium = Medium::Grid(GridMedium::from_field(f.clone(), bench.params).expect("octree"));
         g.bench_function("beam_mask", |b| {
-            b.iter(|| pool.install(|| bench.render_grid(&f, &tree, &mut film(), 0, 7)))
+            b.iter(|| pool.install(|| bench.render_medium(&medium, &mut film(), 0, 7)))
         });
     }
     g.finish();

@@ -38,7 +38,7 @@
 //! | `libm` | no | float functions from `libm` for `no_std` builds |
 //! | `parallel` | no | rows traced and films splatted with rayon (implies `std`); images stay bit-identical |
 //! | `png` | no | [`BackgroundChoice::read_png`]: BOS background images from PNG files (implies `std`) |
-//! | `mesh` | no | unstructured meshes (`rt_volume::UnstructuredField`) on every optical system: `Bench::render_mesh`, `Bos::render_mesh`, `FocusingSchlieren::render_mesh` (implies `std`) |
+//! | `mesh` | no | multifield colour on unstructured meshes (`Bench::render_mesh_colored`); meshes on every instrument come through `render_medium` with `rt-volume`'s `mesh` (implies `std`) |
 //!
 //! Without `std`, one of `std` or `libm` must be on; an allocator is always
 //! needed (films and photon rows live on `alloc`).
@@ -117,7 +117,7 @@ pub use setup::{
     traced_per_pixel,
 };
 // The types in this crate's signatures, from the crates below it (and
-// `build_octree`, the only way to the `Octree` that `render_grid` takes).
+// `build_octree`, the way to a grid's `Octree`).
 pub use rt_core::ColorMap;
 #[cfg(feature = "mesh")]
 pub use rt_volume::{Cell, MeshError, SmoothField, UnstructuredField};

@@ -11,8 +11,12 @@ use crate::{
 };
 
 impl Bench {
-    /// Adds one pass to `film` through `medium` (see [`Bench::render`];
-    /// a grid as [`Bench::render_grid`]).
+    /// Adds one pass to `film` through `medium` (see [`Bench::render`]):
+    /// a grid on its octree's fast path — photons cross the field's smooth
+    /// regions in straight steps within the tolerance the bench cannot
+    /// resolve ([`Bench::skip_tolerance`]), and photons whose line meets no
+    /// node too rough for it go straight without walking the tree; a mesh
+    /// traced exactly or with its recovered gradients.
     ///
     /// # Errors
     /// As [`Bench::render`].
@@ -38,14 +42,16 @@ impl Bench {
     ///
     /// # Errors
     /// As [`Bench::render`].
-    pub fn probe_medium(&self, medium: &Medium, film: &mut Film) -> Result<(), BenchError> {
+    pub(crate) fn probe_medium(&self, medium: &Medium, film: &mut Film) -> Result<(), BenchError> {
         self.render_with(&|o, d| medium.trace(o, d, None), film, 0, 0x5eed)
     }
 }
 
 impl Bos {
-    /// The images through `medium` (see [`Bos::render`]; a grid as
-    /// [`Bos::render_grid`]).
+    /// The images through `medium` (see [`Bos::render`]); a grid with
+    /// octree skipping within a per-ray budget of
+    /// [`Bos::resolvable_deflection`] at the field's centre (the ground
+    /// truth moves by at most a tenth of a pixel).
     ///
     /// # Errors
     /// As [`Bos::render`].
@@ -64,8 +70,9 @@ impl Bos {
 }
 
 impl FocusingSchlieren {
-    /// The images through `medium` (see [`FocusingSchlieren::render`]; a
-    /// grid as [`FocusingSchlieren::render_grid`]).
+    /// The images through `medium` (see [`FocusingSchlieren::render`]); a
+    /// grid with octree skipping within a per-ray budget of
+    /// [`FocusingSchlieren::resolvable_deflection`].
     ///
     /// # Errors
     /// As [`FocusingSchlieren::render`].

@@ -9,6 +9,7 @@ use rt_photo::{
     Bench, BenchError, Cutoff, CutoffError, CutoffParam, Film, FilmError, Filter, Mode, Photon,
     Reconstruction, Weighting,
 };
+use rt_photo::{GridMedium, Medium};
 use rt_volume::{Bounds, Constant, GaussianBump, TraceParams};
 use support::{bench, knife};
 
@@ -373,17 +374,17 @@ fn gridded_bump() -> rt_volume::GridField {
 #[test]
 fn grid_render_with_octree_matches_plain_tracing() {
     let f = gridded_bump();
-    let tree = rt_volume::build_octree(&f).unwrap();
     let b = Bench { params: TraceParams::for_grid(&f), ..bench(knife(300.0), 2) };
     let mut film = Film::new(64, 64, Filter::Box).unwrap();
     assert_eq!(b.skip_tolerance(&f, &film), (1.0 / 300.0) / 1000.0);
     let mut plain = film.clone();
     b.render(&f, &mut plain, 0, 5).unwrap();
+    let medium = Medium::Grid(GridMedium::from_field(f.clone(), b.params).unwrap());
     let render = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
             let mut film = Film::new(64, 64, Filter::Box).unwrap();
-            b.render_grid(&f, &tree, &mut film, 0, 5).unwrap();
+            b.render_medium(&medium, &mut film, 0, 5).unwrap();
             film
         })
     };

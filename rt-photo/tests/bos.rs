@@ -3,6 +3,7 @@
 
 use glam::DVec3;
 use rt_photo::{Background, Bos, DotBackground, DotGrid, ImageBackground, ThinLens, TraceParams};
+use rt_photo::{GridMedium, Medium};
 use rt_volume::{Bounds, Constant, GaussianBump};
 
 /// docs/oracles.md §7's camera: f = 0.1 m focused on the background at Z_B = 2.1 m
@@ -339,7 +340,7 @@ fn bad_background_images_are_errors() {
 /// at any thread count.
 #[test]
 fn grid_render_with_octree_matches_plain_tracing() {
-    use rt_volume::{Grid, GridField, Interp, build_octree};
+    use rt_volume::{Grid, GridField, Interp};
     let (n, h, z_a) = (64, 1e-3, 1.1);
     let half = 0.5 * h * (n - 1) as f64;
     let origin = DVec3::new(-half, -half, z_a - half);
@@ -355,7 +356,6 @@ fn grid_render_with_octree_matches_plain_tracing() {
     }
     let g = Grid::new([n; 3], origin, DVec3::splat(h), data).unwrap();
     let field = GridField::new(g, Interp::CatmullRom, 1.0).unwrap();
-    let tree = build_octree(&field).unwrap();
     // 50 µm pixels: the 48 × 40 image spans ±12 mm of the bump (σ = 1 cm,
     // δ = 1e-3: 1.5 px at the peak).
     let cam = ThinLens { pixel_pitch: 5e-5, ..camera(16.0, 48, 40) };
@@ -363,9 +363,10 @@ fn grid_render_with_octree_matches_plain_tracing() {
     // 0.1 px of 50 µm at M = 0.05 over Z_D = 1 m: 1e-4 rad.
     assert!((b.resolvable_deflection(z_a) - 1e-4).abs() < 1e-15);
     let plain = b.render(&field, 3).unwrap();
+    let medium = Medium::Grid(GridMedium::from_field(field.clone(), b.params).unwrap());
     let render = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| b.render_grid(&field, &tree, 3).unwrap())
+        pool.install(|| b.render_medium(&medium, 3).unwrap())
     };
     let fast = render(1);
     assert_eq!(fast, render(3));

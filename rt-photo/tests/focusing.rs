@@ -5,6 +5,7 @@
 use glam::DVec3;
 use rt_core::sampling::{rng_for, uniform_f64};
 use rt_photo::{FocusingError, FocusingSchlieren, SourceGrid, ThinLens, TraceParams};
+use rt_photo::{GridMedium, Medium};
 use rt_volume::{Bounds, Constant, FnField, GaussianBump, IndexField, trace};
 
 /// f = 0.1 m at f/2 (D = 5 cm) focused at Z_F = 1 m (M = 1/9), pixels of
@@ -406,7 +407,7 @@ fn bad_set_ups_are_errors() {
 /// shift, so few change band) and repeats bit for bit at any thread count.
 #[test]
 fn grid_render_with_octree_matches_plain_tracing() {
-    use rt_volume::{Grid, GridField, Interp, build_octree};
+    use rt_volume::{Grid, GridField, Interp};
     let (n, h) = (48, 0.5e-3);
     let origin = DVec3::new(-0.5 * h * (n - 1) as f64, -0.5 * h * (n - 1) as f64, 0.988);
     let mut data = Vec::with_capacity(n * n * n);
@@ -420,16 +421,16 @@ fn grid_render_with_octree_matches_plain_tracing() {
     }
     let g = Grid::new([n; 3], origin, DVec3::splat(h), data).unwrap();
     let field = GridField::new(g, Interp::Trilinear, 1.0).unwrap();
-    let tree = build_octree(&field).unwrap();
     let grid = SourceGrid { pitch: 4e-3, duty: 0.5, angle: 0.5, bands: None };
     let fs = FocusingSchlieren {
         params: TraceParams::for_grid(&field),
         ..set_up(camera(40, 30), grid, 0.25, 8)
     };
     let plain = fs.render(&field, 4).unwrap().relative();
+    let medium = Medium::Grid(GridMedium::from_field(field.clone(), fs.params).unwrap());
     let render = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| fs.render_grid(&field, &tree, 4).unwrap())
+        pool.install(|| fs.render_medium(&medium, 4).unwrap())
     };
     let skipping = render(1);
     assert_eq!(skipping, render(3));

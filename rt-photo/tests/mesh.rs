@@ -6,6 +6,7 @@
 mod support;
 
 use rt_core::frame::linear_to_srgb;
+use rt_photo::Medium;
 use rt_photo::glam::DVec3;
 use rt_photo::rt_volume::{Grid, GridField, IndexField, Interp};
 use rt_photo::{Cell, Film, Filter, UnstructuredField};
@@ -71,7 +72,8 @@ fn grid_and_its_tetrahedra_give_the_same_image() {
         let params = rt_photo::TraceParams::for_grid(&grid);
         let gb = rt_photo::Bench { params, ..b.clone() };
         let g = knife_image(|film| gb.render(&grid, film, 0, 1).unwrap());
-        let m = knife_image(|film| b.render_mesh(&mesh, film, 0, 1).unwrap());
+        let mesh = Medium::ExactMesh(mesh);
+        let m = knife_image(|film| b.render_medium(&mesh, film, 0, 1).unwrap());
         let contrast = g.iter().fold(0.0f32, |a, &v| a.max((v - 1.0).abs()));
         assert!(contrast > 0.2, "the bump shows: contrast {contrast}");
         diffs.push(max_diff(&g, &m));
@@ -92,7 +94,8 @@ fn linear_field_gives_the_same_image() {
     let m = mesh(5, lo, hi, &lin);
     let b = bench(knife(20.0), 2);
     let gi = knife_image(|film| b.render(&g, film, 0, 3).unwrap());
-    let mi = knife_image(|film| b.render_mesh(&m, film, 0, 3).unwrap());
+    let m = Medium::ExactMesh(m);
+    let mi = knife_image(|film| b.render_medium(&m, film, 0, 3).unwrap());
     // The uniform deflection cuts the knife edge to a level far from 0.5.
     assert!((gi[0] - 1.0).abs() > 0.1, "{}", gi[0]);
     // Pixels away from the outer half cell, where the trilinear grid

@@ -6,6 +6,7 @@
 
 mod support;
 
+use rt_photo::Medium;
 use rt_photo::glam::DVec3;
 use rt_photo::rt_volume::{Grid, GridField, Interp};
 use rt_photo::{
@@ -183,7 +184,8 @@ fn symmetric_flow_gives_a_symmetric_knife_edge_image() {
         let params = smooth.params();
         for &(angle, name, flip_rows) in &angles {
             let b = bench(angle, params);
-            let img = image(|film, pass| b.render_mesh(&exact, film, pass, SEED).unwrap());
+            let exact = Medium::ExactMesh(exact.clone());
+            let img = image(|film, pass| b.render_medium(&exact, film, pass, SEED).unwrap());
             let a = asymmetry(&img, flip_rows);
             report.push(format!("exact {how:?} {name}: {:.3} %", 100.0 * a));
             worst = worst.max(a);

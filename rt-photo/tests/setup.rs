@@ -89,20 +89,29 @@ fn each_cutoff_chooses_from_the_data() {
     assert_eq!(n_ref, m.ambient());
 }
 
-/// One render over a medium is the per-field render it stands for, bit
-/// for bit: the octree's fast path for a grid.
+/// A render over a medium traces with the medium's settings, not the
+/// instrument's: a bench carrying other settings gives the same image,
+/// and the medium's settings, replaced, change it.
 #[test]
-fn rendering_a_medium_is_the_grids_fast_path() {
-    let m = medium(Interp::CatmullRom);
-    let Medium::Grid(g) = &m else { panic!("a grid") };
+fn a_medium_carries_its_trace_settings() {
+    let mut m = medium(Interp::CatmullRom);
     let o = SchlierenOptions { size: 40, photons: 4, ..SchlierenOptions::default() };
     let setup = SchlierenSetup::choose(&m, &o).unwrap();
     let bench = Bench { strata: 2, ..setup.bench.clone() };
-    let (mut a, mut b) =
-        (Film::new(40, 40, Filter::Tent).unwrap(), Film::new(40, 40, Filter::Tent).unwrap());
+    let other = Bench { params: rt_photo::TraceParams::accurate(), ..bench.clone() };
+    let film = || Film::new(40, 40, Filter::Tent).unwrap();
+    let (mut a, mut b, mut c) = (film(), film(), film());
     bench.render_medium(&m, &mut a, 0, 7).unwrap();
-    bench.render_grid(g.field(), g.tree(), &mut b, 0, 7).unwrap();
+    other.render_medium(&m, &mut b, 0, 7).unwrap();
     assert_eq!(a.normalized_f64(), b.normalized_f64());
+    let coarse = m.params();
+    m.set_params(rt_photo::TraceParams {
+        step: 4.0 * coarse.step,
+        max_step: 4.0 * coarse.max_step,
+        ..coarse
+    });
+    bench.render_medium(&m, &mut c, 0, 7).unwrap();
+    assert_ne!(a.normalized_f64(), c.normalized_f64());
 }
 
 /// BOS and focusing set-ups render, and say what they chose.

@@ -20,7 +20,7 @@ use core::fmt;
 
 use glam::DVec3;
 use rt_core::sampling::{rng_for, uniform_f64};
-use rt_volume::{GridField, IndexField, Octree, TraceError, TraceParams, TraceResult, trace};
+use rt_volume::{IndexField, TraceError, TraceParams, TraceResult, trace};
 
 use super::Background;
 use crate::camera::{Basis, CameraError, ThinLens};
@@ -167,33 +167,6 @@ impl Bos {
         let z_d = self.background_distance - z_a;
         let tol = 0.1 * cam.pixel_pitch / (cam.magnification() * z_d);
         if tol.is_finite() && tol > 0.0 { tol.min(1e-3) } else { 1e-3 }
-    }
-
-    /// [`Bos::render`] for a gridded field, rt's default: octree skipping
-    /// (`tree` from [`rt_volume::build_octree`]) within a per-ray budget of
-    /// [`Bos::resolvable_deflection`] at the field's centre — the ground
-    /// truth moves by at most a tenth of a pixel. With a tree built for
-    /// another interpolant, traced without skipping.
-    ///
-    /// # Errors
-    /// As [`Bos::render`].
-    pub fn render_grid(
-        &self,
-        field: &GridField,
-        tree: &Octree,
-        seed: u64,
-    ) -> Result<BosImages, BosError> {
-        if field.interp() != tree.interp() {
-            return self.render(field, seed);
-        }
-        let b = field.bounds();
-        let axis = self.camera.direction.normalize();
-        let z_a = (0.5 * (b.min + b.max) - self.camera.position).dot(axis);
-        let tol = self.resolvable_deflection(z_a);
-        self.render_with(
-            &|o, d| rt_volume::trace_skipping(field, tree, o, d, &self.params, tol),
-            seed,
-        )
     }
 
     /// [`Bos::render`] with any tracer `(origin, direction) → result`.

@@ -45,7 +45,7 @@ use core::fmt;
 
 use glam::DVec3;
 use rt_core::sampling::{rng_for, uniform_f64};
-use rt_volume::{GridField, IndexField, Octree, TraceError, TraceParams, TraceResult, trace};
+use rt_volume::{IndexField, TraceError, TraceParams, TraceResult, trace};
 
 use crate::camera::{Basis, ThinLens};
 use crate::math::{atan2, cos, floor, sin, sqrt};
@@ -352,7 +352,7 @@ impl FocusingSchlieren {
     /// The smallest deflection (radians) the set-up resolves: the one
     /// that changes a pixel's relative intensity by 1/1000 (`δ/o`, with
     /// `δ = ε·(Z_S − Z_F)` from the focus plane). Octree skipping spends
-    /// it as each ray's budget ([`FocusingSchlieren::render_grid`]).
+    /// it as each ray's budget ([`FocusingSchlieren::render_medium`] of a grid).
     #[must_use]
     pub fn resolvable_deflection(&self) -> f64 {
         let lever = (self.source_distance - self.camera.focus_distance).max(f64::MIN_POSITIVE);
@@ -373,29 +373,6 @@ impl FocusingSchlieren {
         seed: u64,
     ) -> Result<FocusingImages, FocusingError> {
         self.render_with(&|o, d| trace(field, o, d, &self.params), seed)
-    }
-
-    /// [`FocusingSchlieren::render`] for a gridded field, rt's default:
-    /// octree skipping (`tree` from [`rt_volume::build_octree`]) within a
-    /// per-ray budget of [`FocusingSchlieren::resolvable_deflection`].
-    /// With a tree built for another interpolant, traced without skipping.
-    ///
-    /// # Errors
-    /// As [`FocusingSchlieren::render`].
-    pub fn render_grid(
-        &self,
-        field: &GridField,
-        tree: &Octree,
-        seed: u64,
-    ) -> Result<FocusingImages, FocusingError> {
-        if field.interp() != tree.interp() {
-            return self.render(field, seed);
-        }
-        let tol = self.resolvable_deflection();
-        self.render_with(
-            &|o, d| rt_volume::trace_skipping(field, tree, o, d, &self.params, tol),
-            seed,
-        )
     }
 
     /// [`FocusingSchlieren::render`] with any tracer `(origin, direction)

@@ -96,7 +96,7 @@ pub enum BenchError {
     /// carries each cell's mean transmission, never a random 0 or 1.
     SheetRoulette,
     /// Tracing a photon failed (or building the beam mask of
-    /// [`Bench::render_grid`]).
+    /// [`Bench::render_medium`] on a grid).
     Trace(TraceError),
 }
 
@@ -404,31 +404,13 @@ impl Bench {
         resolvable.min(1e-3)
     }
 
-    /// [`Bench::render`] for a gridded field, rt's default: the octree
-    /// `tree` (from [`rt_volume::build_octree`]) lets photons cross the
-    /// field's smooth regions in straight steps, with the tolerance the
-    /// bench cannot resolve ([`Bench::skip_tolerance`]); photons whose line
-    /// meets no node too rough for it (a [`BeamMask`] with one cell per
-    /// film pixel) go straight without walking the tree. Pair it with
-    /// [`TraceParams::for_grid`]. The tree must bound the field's own
-    /// interpolant (trilinear or Catmull–Rom: [`rt_volume::build_octree`]
-    /// builds it so); with a tree built for another, the field is traced
-    /// without skipping.
-    ///
-    /// # Errors
-    /// As [`Bench::render`].
-    pub fn render_grid(
-        &self,
-        field: &GridField,
-        tree: &Octree,
-        film: &mut Film,
-        pass: u64,
-        seed: u64,
-    ) -> Result<(), BenchError> {
-        self.render_grid_with(field, tree, &self.params, film, pass, seed)
-    }
-
-    /// [`Bench::render_grid`] with the trace settings `params`.
+    /// [`Bench::render`] for a gridded field on the fast path
+    /// ([`Bench::render_medium`] of a grid): the octree `tree` lets photons
+    /// cross the field's smooth regions in straight steps, with the
+    /// tolerance the bench cannot resolve ([`Bench::skip_tolerance`]);
+    /// photons whose line meets no node too rough for it (a [`BeamMask`]
+    /// with one cell per film pixel) go straight without walking the tree.
+    /// With a tree built for another interpolant, traced without skipping.
     pub(crate) fn render_grid_with(
         &self,
         field: &GridField,

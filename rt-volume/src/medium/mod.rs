@@ -70,6 +70,15 @@ impl GridMedium {
         Ok(Self { field, tree, params })
     }
 
+    /// `field` as it is (its own ambient index), traced with `params`.
+    ///
+    /// # Errors
+    /// [`MediumError::Octree`] for a grid under 2 samples a side.
+    pub fn from_field(field: GridField, params: TraceParams) -> Result<Self, MediumError> {
+        let tree = build_octree(&field)?;
+        Ok(Self { field, tree, params })
+    }
+
     /// The field.
     #[must_use]
     pub fn field(&self) -> &GridField {

@@ -17,9 +17,10 @@ use std::{fmt::Write as _, path::Path};
 use glam::DVec3;
 use rt_benches::plot::{Plot, Series, loglog};
 use rt_photo::{
-    Background, Bos, BosImages, DotBackground, GridField, ThinLens, TraceParams, build_octree,
+    Background, Bos, BosImages, DotBackground, GridField, ThinLens, TraceParams,
     rt_volume::{GaussianBump, Grid, Interp, Method},
 };
+use rt_photo::{GridMedium, Medium};
 
 use crate::{
     Section,
@@ -96,15 +97,18 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let analytic = GaussianBump::new(DVec3::new(0.0, 0.0, Z_A), DELTA, SIGMA, 5.0);
     let linear = gridded(Interp::Trilinear)?;
     let cubic = gridded(Interp::CatmullRom)?;
-    let (tree_l, tree_c) = (
-        build_octree(&linear).map_err(|e| e.to_string())?,
-        build_octree(&cubic).map_err(|e| e.to_string())?,
-    );
     let for_grid = TraceParams::for_grid(&linear);
     // The command line's integrator: leapfrog, steps of two cells.
     let leapfrog =
         TraceParams { step: 2.0 * for_grid.step, max_step: 2.0 * for_grid.max_step, ..for_grid };
     let rk4 = TraceParams::fixed(Method::Rk4, for_grid.step);
+    // The grids as media on their octrees' fast path, with each integrator.
+    let medium = |field: &GridField, params| -> Result<Medium, String> {
+        let grid = GridMedium::from_field(field.clone(), params).map_err(|e| e.to_string())?;
+        Ok(Medium::Grid(grid))
+    };
+    let (leap_l, rk4_l, rk4_c) =
+        (medium(&linear, leapfrog)?, medium(&linear, rk4)?, medium(&cubic, rk4)?);
     let samples: &[u32] = if quick { &[1, 2] } else { &[1, 2, 4] };
     let mut csv = String::from("case,method,samples,seconds,displacement_rmse_px\n");
     let mut md = String::from(
@@ -140,15 +144,11 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             (
                 "grid-leapfrog-2cell-octree",
                 leapfrog,
-                Box::new(|b: &Bos| b.render_grid(&linear, &tree_l, 2)),
+                Box::new(|b: &Bos| b.render_medium(&leap_l, 2)),
             ),
             ("grid-rk4-1cell", rk4, Box::new(|b: &Bos| b.render(&linear, 2))),
-            ("grid-rk4-1cell-octree", rk4, Box::new(|b: &Bos| b.render_grid(&linear, &tree_l, 2))),
-            (
-                "cubic-grid-rk4-1cell-octree",
-                rk4,
-                Box::new(|b: &Bos| b.render_grid(&cubic, &tree_c, 2)),
-            ),
+            ("grid-rk4-1cell-octree", rk4, Box::new(|b: &Bos| b.render_medium(&rk4_l, 2))),
+            ("cubic-grid-rk4-1cell-octree", rk4, Box::new(|b: &Bos| b.render_medium(&rk4_c, 2))),
         ];
         for (name, params, run) in &methods {
             let mut points = Vec::new();
@@ -179,7 +179,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         // The octree's own effect: skipping against the same integrator.
         let b = bos(samples[samples.len() - 1], leapfrog);
         let plain = b.render(&linear, 2).map_err(|e| e.to_string())?;
-        let fast = b.render_grid(&linear, &tree_l, 2).map_err(|e| e.to_string())?;
+        let fast = b.render_medium(&leap_l, 2).map_err(|e| e.to_string())?;
         let moved = plain
             .displacement
             .iter()

@@ -19,9 +19,9 @@ use rt_benches::{
     scenes::{knife_bench, sparse_bumps},
 };
 use rt_photo::{
-    Bench, Film, Filter, Reconstruction, SchlierenOptions, SchlierenSetup, TraceParams,
-    build_octree, lattice,
+    Bench, Film, Filter, Reconstruction, SchlierenOptions, SchlierenSetup, TraceParams, lattice,
 };
+use rt_photo::{GridMedium, Medium};
 use rt_tools::builtin::blast_wave;
 
 use crate::{
@@ -205,13 +205,13 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     // The schlieren area's `rt` setting on its sparse field, in this run:
     // one photon per pixel of a 128² film, best of 3.
     let f = sparse_bumps();
-    let tree = build_octree(&f).map_err(|e| e.to_string())?;
     let b = knife_bench(TraceParams::for_grid(&f), 1);
+    let medium = Medium::Grid(GridMedium::from_field(f, b.params).map_err(|e| e.to_string())?);
     let mut samples = Samples::default();
     let mut emitted = 0;
     for _ in 0..3 {
         let mut film = Film::new(128, 128, Filter::Box).map_err(|e| e.to_string())?;
-        let (t, r) = time(|| b.render_grid(&f, &tree, &mut film, 0, 7));
+        let (t, r) = time(|| b.render_medium(&medium, &mut film, 0, 7));
         r.map_err(|e| e.to_string())?;
         samples.0.push(t);
         emitted = film.emitted;

@@ -1,6 +1,6 @@
 //! Knife-edge schlieren of a sparse 128³ gridded field: the original
 //! scheme (explicit Euler, one-voxel step, trilinear, no octree) against
-//! rt's default for grids (`Bench::render_grid`: leapfrog with octree
+//! rt's default for grids (`Bench::render_medium` on a grid: leapfrog with octree
 //! skipping at the bench's tolerance), at one and two voxels per step;
 //! image RMSE against a converged reference, over photon counts.
 
@@ -11,6 +11,7 @@ use rt_benches::{
     scenes::{knife_bench, sparse_bumps},
 };
 use rt_photo::{Film, Filter};
+use rt_photo::{GridMedium, Medium};
 use rt_volume::{Method, TraceParams, build_octree, trace, trace_skipping};
 
 use crate::{
@@ -54,6 +55,8 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         for (name, params) in runs {
             // Best of 3 (the film of the last run is kept; all are equal).
             let b = knife_bench(params, k);
+            let medium =
+                Medium::Grid(GridMedium::from_field(f.clone(), params).map_err(|e| e.to_string())?);
             let mut samples = Samples::default();
             let mut film = Film::new(FILM, FILM, Filter::Box).map_err(|e| e.to_string())?;
             for _ in 0..3 {
@@ -61,7 +64,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
                 let (t, r) = if name == "original" {
                     time(|| b.render_with(&|o, d| trace(&f, o, d, &b.params), &mut film, 0, 7))
                 } else {
-                    time(|| b.render_grid(&f, &tree, &mut film, 0, 7))
+                    time(|| b.render_medium(&medium, &mut film, 0, 7))
                 };
                 r.map_err(|e| e.to_string())?;
                 samples.0.push(t);
