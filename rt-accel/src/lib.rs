@@ -49,37 +49,23 @@ extern crate alloc;
 #[cfg(feature = "std")]
 extern crate std;
 
-#[cfg(feature = "alloc")]
-mod aligned;
-#[cfg(feature = "obvhs")]
-mod build;
-#[cfg(feature = "alloc")]
-mod bvh;
-mod bytes;
-#[cfg(feature = "alloc")]
-mod check;
+mod construct;
 mod error;
-#[cfg(feature = "alloc")]
-mod instance;
-mod isa;
-#[cfg(feature = "alloc")]
-mod mesh;
-mod node;
-mod packet;
-#[cfg(feature = "alloc")]
-mod pages;
-mod prim;
-mod ray_ctx;
-#[cfg(feature = "alloc")]
-mod refit;
-#[cfg(feature = "obvhs")]
-mod sah;
-#[cfg(feature = "alloc")]
-mod scene;
-mod simd;
-mod stream;
+mod layout;
+mod primitives;
 mod traverse;
-mod tri_packet;
+
+// The folders group the concepts; the modules keep their crate-level
+// paths (`crate::node`, `crate::sah`, …).
+#[cfg(feature = "obvhs")]
+use construct::{build, sah};
+#[cfg(feature = "alloc")]
+use layout::{aligned, bvh, check, pages};
+use layout::{bytes, node};
+#[cfg(feature = "alloc")]
+use primitives::{instance, mesh, scene};
+use primitives::{prim, tri_packet};
+use traverse::{isa, packet, ray_ctx, simd, stream};
 
 #[cfg(feature = "alloc")]
 pub use aligned::{AlignedBytes, BYTES_ALIGN};

@@ -15,7 +15,7 @@
 
 use core::fmt;
 
-use crate::frame::{linear_to_srgb, srgb_to_linear};
+use crate::srgb::{linear_to_srgb, srgb_to_linear};
 
 /// One control point: a position in `[0, 1]` and a straight (not
 /// premultiplied) sRGB-encoded colour with a linear alpha, as colour-map

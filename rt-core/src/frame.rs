@@ -3,7 +3,7 @@
 use alloc::vec::Vec;
 use core::fmt;
 
-use crate::math::powf;
+pub use crate::srgb::{linear_to_srgb, srgb_to_linear};
 
 /// One pixel: premultiplied linear RGBA and depth (the ray parameter `t` of
 /// the visible surface; `+∞` for background).
@@ -132,22 +132,6 @@ impl Frame {
         }
         out
     }
-}
-
-/// The sRGB transfer function (IEC 61966-2-1) for linear `x ∈ [0, 1]`
-/// (clamped; NaN → 0).
-#[must_use]
-pub fn linear_to_srgb(x: f32) -> f32 {
-    let x = if x > 0.0 { x.min(1.0) } else { 0.0 };
-    if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * powf(x, 1.0 / 2.4) - 0.055 }
-}
-
-/// The inverse of [`linear_to_srgb`]: linear light of an sRGB-encoded
-/// `x ∈ [0, 1]` (clamped; NaN → 0).
-#[must_use]
-pub fn srgb_to_linear(x: f32) -> f32 {
-    let x = if x > 0.0 { x.min(1.0) } else { 0.0 };
-    if x <= 0.040_45 { x / 12.92 } else { powf((x + 0.055) / 1.055, 2.4) }
 }
 
 fn to_u8(x: f32) -> u8 {

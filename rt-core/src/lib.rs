@@ -52,6 +52,7 @@ pub mod intersect;
 mod math;
 mod ray;
 pub mod sampling;
+pub mod srgb;
 
 pub use aabb::Aabb;
 pub use camera::{Camera, CameraError, Projection};

@@ -1,9 +1,19 @@
 //! Closest-hit and occlusion traversal of a borrowed BVH: no std, no
-//! allocation, a fixed stack.
+//! allocation, a fixed stack. The queries and their step loops
+//! ([`query`]), the node tests ([`node_test`]) and child order
+//! ([`order`]); a ray's precomputed constants ([`ray_ctx`]); eight-ray
+//! packets ([`packet`]) and streams of rays sorted into coherent groups
+//! ([`stream`]); the SIMD lanes ([`simd`]) and the instruction set picked
+//! at run time ([`isa`]).
 
+pub(crate) mod isa;
 mod node_test;
 mod order;
+pub(crate) mod packet;
 mod query;
+pub(crate) mod ray_ctx;
+pub(crate) mod simd;
+pub(crate) mod stream;
 
 #[cfg(all(test, target_arch = "x86_64"))]
 pub(crate) use node_test::box_lanes_fused;

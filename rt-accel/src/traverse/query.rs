@@ -302,7 +302,7 @@ impl<'a, P: Primitive> BvhRef<'a, P> {
     }
 
     /// Inner node `c`, found by its byte offset (no multiply on the
-    /// traversal's chain, see `node.rs`).
+    /// traversal's chain, see `layout/node.rs`).
     #[inline(always)]
     pub(crate) fn node(&self, c: ChildRef) -> &'a Node {
         debug_assert!(

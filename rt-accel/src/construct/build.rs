@@ -1,5 +1,5 @@
 //! Building (feature `obvhs`): a binary BVH, from our binned SAH builder
-//! (`sah.rs`, the default) or obvhs's PLOC + reinsertion + leaf collapse
+//! (`construct/sah.rs`, the default) or obvhs's PLOC + reinsertion + leaf collapse
 //! presets, then the 8-wide layout of least SAH cost over it (Ylitie et
 //! al. 2017's dynamic programming).
 //!
