@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 use rt_core::{Camera, Projection, Ray, glam::Vec2, sampling};
-use rt_photo::{Bench, Cutoff, Mode, Reconstruction, Weighting};
+use rt_photo::{Cutoff, Mode, Reconstruction, SchlierenBench, Weighting};
 use rt_volume::{Cell, Grid, GridField, Interp, TraceParams, glam::DVec3};
 
 /// An indexed triangle mesh.
@@ -133,8 +133,8 @@ pub fn dense_bumps() -> GridField {
 /// The schlieren report's bench: a knife edge (f/h = 250) on a beam along
 /// z over the unit square, `strata²` photons per pixel.
 #[must_use]
-pub fn knife_bench(params: TraceParams, strata: u32) -> Bench {
-    Bench {
+pub fn knife_bench(params: TraceParams, strata: u32) -> SchlierenBench {
+    SchlierenBench {
         center: DVec3::new(0.5, 0.5, -0.1),
         direction: DVec3::Z,
         u: DVec3::X,

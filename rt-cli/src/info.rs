@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use rt_photo::{
-    Bench, Cell, Cutoff, Medium, MeshTrace, Mode, Survey,
+    Cell, Cutoff, Medium, MeshTrace, Mode, SchlierenBench, Survey,
     units::{index, si, sig3},
 };
 use rt_surface::io::{MeshData, read_mesh};
@@ -190,7 +190,7 @@ fn unstructured(a: &Args) -> anyhow::Result<String> {
 
 /// The survey's line of `rt info`.
 fn survey_line(a: &Args, medium: &Medium) -> anyhow::Result<String> {
-    let probe = Bench::through(
+    let probe = SchlierenBench::through(
         medium.bounds(),
         a.axis.into(),
         Mode::Schlieren(Cutoff::None),

@@ -38,7 +38,7 @@
 //! | `libm` | no | float functions from `libm` for `no_std` builds |
 //! | `parallel` | no | rows traced and films splatted with rayon (implies `std`); images stay bit-identical |
 //! | `png` | no | [`BackgroundChoice::read_png`]: BOS background images from PNG files (implies `std`) |
-//! | `mesh` | no | multifield colour on unstructured meshes (`Bench::render_mesh_colored`); meshes on every instrument come through `render_medium` with `rt-volume`'s `mesh` (implies `std`) |
+//! | `mesh` | no | multifield colour on unstructured meshes (`SchlierenBench::render_mesh_colored`); meshes on every instrument come through `render_medium` with `rt-volume`'s `mesh` (implies `std`) |
 //!
 //! Without `std`, one of `std` or `libm` must be on; an allocator is always
 //! needed (films and photon rows live on `alloc`).
@@ -50,11 +50,11 @@
 //! ```
 //! use rt_photo::glam::DVec3;
 //! use rt_photo::rt_volume::GaussianBump;
-//! use rt_photo::{Bench, Cutoff, Film, Filter, Mode, Reconstruction, TraceParams, Weighting};
+//! use rt_photo::{SchlierenBench, Cutoff, Film, Filter, Mode, Reconstruction, TraceParams, Weighting};
 //!
 //! // n = 1 + 1e-4·exp(−r²/2), σ = 1, cut off beyond r = 5.
 //! let field = GaussianBump::new(DVec3::ZERO, 1e-4, 1.0, 5.0);
-//! let bench = Bench {
+//! let bench = SchlierenBench {
 //!     center: DVec3::new(0.0, 0.0, -6.0), // the beam starts upstream
 //!     direction: DVec3::Z,
 //!     u: DVec3::X,
@@ -108,8 +108,8 @@ pub use focusing::{
     FocusingError, FocusingImages, FocusingRig, FocusingRigOptions, FocusingSchlieren, SourceGrid,
 };
 pub use schlieren::{
-    Bench, BenchError, Cutoff, CutoffError, CutoffParam, Film, FilmError, Filter, FilterImage,
-    Mode, Photon, Reconstruction, Weighting,
+    BenchError, Cutoff, CutoffError, CutoffParam, Film, FilmError, Filter, FilterImage, Mode,
+    Photon, Reconstruction, SchlierenBench, Weighting,
 };
 pub use setup::{
     Axis, BackgroundChoice, BosOptions, BosSetup, CutoffKind, FocusingOptions, FocusingSetup,

@@ -6,20 +6,20 @@
 use rt_volume::{Medium, TraceParams};
 
 use crate::{
-    Bench, BenchError, Bos, BosError, BosImages, Film, FocusingError, FocusingImages,
-    FocusingSchlieren,
+    BenchError, Bos, BosError, BosImages, Film, FocusingError, FocusingImages, FocusingSchlieren,
+    SchlierenBench,
 };
 
-impl Bench {
-    /// Adds one pass to `film` through `medium` (see [`Bench::render`]):
+impl SchlierenBench {
+    /// Adds one pass to `film` through `medium` (see [`SchlierenBench::render`]):
     /// a grid on its octree's fast path — photons cross the field's smooth
     /// regions in straight steps within the tolerance the bench cannot
-    /// resolve ([`Bench::skip_tolerance`]), and photons whose line meets no
+    /// resolve ([`SchlierenBench::skip_tolerance`]), and photons whose line meets no
     /// node too rough for it go straight without walking the tree; a mesh
     /// traced exactly or with its recovered gradients.
     ///
     /// # Errors
-    /// As [`Bench::render`].
+    /// As [`SchlierenBench::render`].
     pub fn render_medium(
         &self,
         medium: &Medium,
@@ -41,7 +41,7 @@ impl Bench {
     /// all), as surveys need.
     ///
     /// # Errors
-    /// As [`Bench::render`].
+    /// As [`SchlierenBench::render`].
     pub(crate) fn probe_medium(&self, medium: &Medium, film: &mut Film) -> Result<(), BenchError> {
         self.render_with(&|o, d| medium.trace(o, d, None), film, 0, 0x5eed)
     }

@@ -7,14 +7,14 @@ use glam::DVec3;
 use rt_core::ColorMap;
 use rt_volume::UnstructuredField;
 
-use crate::{Bench, BenchError, Film};
+use crate::{BenchError, Film, SchlierenBench};
 
-impl Bench {
-    /// [`Bench::render_colored`] for an unstructured mesh: `s̄` is the mean
+impl SchlierenBench {
+    /// [`SchlierenBench::render_colored`] for an unstructured mesh: `s̄` is the mean
     /// of `scalar` at the points where the photon leaves each cell.
     ///
     /// # Errors
-    /// As [`Bench::render`].
+    /// As [`SchlierenBench::render`].
     pub fn render_mesh_colored(
         &self,
         field: &UnstructuredField,

@@ -6,8 +6,8 @@ mod support;
 use glam::DVec3;
 use rt_core::frame::linear_to_srgb;
 use rt_photo::{
-    Bench, BenchError, Cutoff, CutoffError, CutoffParam, Film, FilmError, Filter, Mode, Photon,
-    Reconstruction, Weighting,
+    BenchError, Cutoff, CutoffError, CutoffParam, Film, FilmError, Filter, Mode, Photon,
+    Reconstruction, SchlierenBench, Weighting,
 };
 use rt_photo::{GridMedium, Medium};
 use rt_volume::{Bounds, Constant, GaussianBump, TraceParams};
@@ -161,7 +161,7 @@ fn roulette_has_the_same_expectation() {
 #[test]
 fn deterministic_across_thread_counts_and_progressive() {
     let f = GaussianBump::new(DVec3::ZERO, 2e-3, 1.0, 5.0);
-    let b = Bench { film_distance: 50.0, ..bench(knife(300.0), 2) };
+    let b = SchlierenBench { film_distance: 50.0, ..bench(knife(300.0), 2) };
     let render = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
@@ -183,7 +183,7 @@ fn bad_parameters_are_errors() {
     let mut film = Film::new(8, 8, Filter::Box).unwrap();
     let before = film.clone();
     type IsExpected = fn(BenchError) -> bool;
-    let cases: [(Bench, IsExpected); 6] = [
+    let cases: [(SchlierenBench, IsExpected); 6] = [
         (
             bench(
                 Mode::Schlieren(Cutoff::KnifeEdge { angle: f64::NAN, offset: 0.0, f: 1.0, h: 1.0 }),
@@ -216,7 +216,7 @@ fn bad_parameters_are_errors() {
         ),
         (bench(Mode::Schlieren(Cutoff::None), 0), |e| e == BenchError::Strata(0)),
         (
-            Bench {
+            SchlierenBench {
                 direction: DVec3::new(0.0, 0.0, 2.0),
                 ..bench(Mode::Schlieren(Cutoff::None), 2)
             },
@@ -243,7 +243,7 @@ fn shadowgraph_matches_the_linearised_gaussian() {
     let (delta, sigma, l) = (1e-4, 1.0, 100.0);
     let f = GaussianBump::new(DVec3::ZERO, delta, sigma, 5.0);
     let mut film = Film::new(32, 32, Filter::Tent).unwrap();
-    let b = Bench { film_distance: l, ..bench(Mode::Schlieren(Cutoff::None), 32) };
+    let b = SchlierenBench { film_distance: l, ..bench(Mode::Schlieren(Cutoff::None), 32) };
     b.render(&f, &mut film, 0, 17).unwrap();
     assert!(film.emitted >= 1_000_000);
     let a = SQRT_2PI * delta / sigma;
@@ -329,7 +329,7 @@ fn photons_carry_the_colour_of_a_second_field() {
 #[test]
 fn adaptive_radius_reduces_noise_at_few_photons() {
     let f = GaussianBump::new(DVec3::ZERO, 1e-4, 1.0, 5.0);
-    let b1 = Bench { weighting: Weighting::Roulette, ..bench(knife(1500.0), 1) };
+    let b1 = SchlierenBench { weighting: Weighting::Roulette, ..bench(knife(1500.0), 1) };
     let mut reference = Film::new(64, 64, Filter::Tent).unwrap();
     bench(knife(1500.0), 4).render(&f, &mut reference, 0, 1).unwrap();
     let diff = |a: &Film| {
@@ -374,7 +374,7 @@ fn gridded_bump() -> rt_volume::GridField {
 #[test]
 fn grid_render_with_octree_matches_plain_tracing() {
     let f = gridded_bump();
-    let b = Bench { params: TraceParams::for_grid(&f), ..bench(knife(300.0), 2) };
+    let b = SchlierenBench { params: TraceParams::for_grid(&f), ..bench(knife(300.0), 2) };
     let mut film = Film::new(64, 64, Filter::Box).unwrap();
     assert_eq!(b.skip_tolerance(&f, &film), (1.0 / 300.0) / 1000.0);
     let mut plain = film.clone();
@@ -406,7 +406,7 @@ fn grid_render_with_octree_matches_plain_tracing() {
 fn skip_tolerance_follows_the_optics() {
     let f = gridded_bump();
     let film = Film::new(60, 30, Filter::Box).unwrap();
-    let shadow = Bench { film_distance: 100.0, ..bench(Mode::Schlieren(Cutoff::None), 1) };
+    let shadow = SchlierenBench { film_distance: 100.0, ..bench(Mode::Schlieren(Cutoff::None), 1) };
     // Pixel 0.1 (6/60), seen 100 further: 1e-3 rad; 1/1000 of it.
     assert!((shadow.skip_tolerance(&f, &film) - 1e-6).abs() < 1e-18);
     // At L = 0 without a cutoff nothing is resolved: the cap.
@@ -459,7 +459,7 @@ fn parallel_splat_equals_serial_splat() {
 fn oracles_hold_for_a_bump_of_one_centimetre() {
     let (delta, sigma) = (1e-4, 0.01);
     let f = GaussianBump::new(DVec3::ZERO, delta, sigma, 5.0);
-    let scaled = |mode: Mode, film_distance: f64| Bench {
+    let scaled = |mode: Mode, film_distance: f64| SchlierenBench {
         center: DVec3::new(0.0, 0.0, -6.0 * sigma),
         width: 6.0 * sigma,
         height: 6.0 * sigma,

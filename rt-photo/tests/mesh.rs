@@ -70,7 +70,7 @@ fn grid_and_its_tetrahedra_give_the_same_image() {
     for n in [7, 13, 25] {
         let (grid, mesh) = (grid(n, &bump), mesh(n, -3.0, 3.0, &bump));
         let params = rt_photo::TraceParams::for_grid(&grid);
-        let gb = rt_photo::Bench { params, ..b.clone() };
+        let gb = rt_photo::SchlierenBench { params, ..b.clone() };
         let g = knife_image(|film| gb.render(&grid, film, 0, 1).unwrap());
         let mesh = Medium::ExactMesh(mesh);
         let m = knife_image(|film| b.render_medium(&mesh, film, 0, 1).unwrap());

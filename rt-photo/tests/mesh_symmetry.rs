@@ -10,7 +10,7 @@ use rt_photo::Medium;
 use rt_photo::glam::DVec3;
 use rt_photo::rt_volume::{Grid, GridField, Interp};
 use rt_photo::{
-    Bench, Cell, Cutoff, Film, Filter, Mode, Reconstruction, SmoothField, TraceParams,
+    Cell, Cutoff, Film, Filter, Mode, Reconstruction, SchlierenBench, SmoothField, TraceParams,
     UnstructuredField,
 };
 
@@ -106,9 +106,9 @@ fn grid() -> GridField {
 /// sensitive to the deflection along `angle` (0: image x, π/2: image y),
 /// as `rt schlieren` sets it up (sheet reconstruction, 2 × 2 photons a
 /// pixel per pass).
-fn bench(angle: f64, params: TraceParams) -> Bench {
+fn bench(angle: f64, params: TraceParams) -> SchlierenBench {
     let knife = Mode::Schlieren(Cutoff::KnifeEdge { angle, offset: 0.0, f: 1.0, h: 1e-3 });
-    Bench { reconstruction: Reconstruction::Sheet, params, ..support::bench(knife, 2) }
+    SchlierenBench { reconstruction: Reconstruction::Sheet, params, ..support::bench(knife, 2) }
 }
 
 /// Four passes of `render` onto a fresh film: the image, row by row

@@ -4,8 +4,8 @@
 //! options are refused by name.
 
 use rt_photo::{
-    Axis, Bench, BosOptions, BosSetup, Cutoff, CutoffKind, Film, Filter, FocusingOptions,
-    FocusingSetup, Medium, Mode, SchlierenOptions, SchlierenSetup, SetupError, Survey,
+    Axis, BosOptions, BosSetup, Cutoff, CutoffKind, Film, Filter, FocusingOptions, FocusingSetup,
+    Medium, Mode, SchlierenBench, SchlierenOptions, SchlierenSetup, SetupError, Survey,
     glam::DVec3,
     rt_volume::{GLADSTONE_DALE_AIR, Grid, Interp, Samples},
 };
@@ -41,7 +41,13 @@ fn the_survey_measures_weak_flows() {
     let m =
         Medium::from_grid(bump(48, 1.5e-3, sigma, amp), Samples::AIR, false, Interp::CatmullRom)
             .unwrap();
-    let probe = Bench::through(m.bounds(), Axis::Z, Mode::Schlieren(Cutoff::None), 0.0, m.params());
+    let probe = SchlierenBench::through(
+        m.bounds(),
+        Axis::Z,
+        Mode::Schlieren(Cutoff::None),
+        0.0,
+        m.params(),
+    );
     let survey = Survey::of(&m, &probe, Survey::WIDTH).unwrap();
     let exact = GLADSTONE_DALE_AIR * amp * core::f64::consts::TAU.sqrt() * (-0.5f64).exp();
     let got = survey.magnitude(1.0);
@@ -80,7 +86,13 @@ fn each_cutoff_chooses_from_the_data() {
     assert!(shadow.bench.film_distance > 0.0 && shadow.title() == "Shadowgraph");
     let colour = choose(CutoffKind::Color);
     let Mode::Schlieren(Cutoff::Color(filter)) = &colour.bench.mode else { panic!("colour") };
-    let probe = Bench::through(m.bounds(), Axis::Z, Mode::Schlieren(Cutoff::None), 0.0, m.params());
+    let probe = SchlierenBench::through(
+        m.bounds(),
+        Axis::Z,
+        Mode::Schlieren(Cutoff::None),
+        0.0,
+        m.params(),
+    );
     let largest = Survey::of(&m, &probe, 48).unwrap().magnitude(1.0);
     assert!(filter.half_range > 0.5 * largest && filter.half_range <= largest);
     let Mode::Interferometry { n_ref, .. } = choose(CutoffKind::Interferometry).bench.mode else {
@@ -97,8 +109,8 @@ fn a_medium_carries_its_trace_settings() {
     let mut m = medium(Interp::CatmullRom);
     let o = SchlierenOptions { size: 40, photons: 4, ..SchlierenOptions::default() };
     let setup = SchlierenSetup::choose(&m, &o).unwrap();
-    let bench = Bench { strata: 2, ..setup.bench.clone() };
-    let other = Bench { params: rt_photo::TraceParams::accurate(), ..bench.clone() };
+    let bench = SchlierenBench { strata: 2, ..setup.bench.clone() };
+    let other = SchlierenBench { params: rt_photo::TraceParams::accurate(), ..bench.clone() };
     let film = || Film::new(40, 40, Filter::Tent).unwrap();
     let (mut a, mut b, mut c) = (film(), film(), film());
     bench.render_medium(&m, &mut a, 0, 7).unwrap();

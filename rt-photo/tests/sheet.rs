@@ -6,18 +6,24 @@ mod support;
 
 use glam::DVec3;
 use rt_photo::{
-    Bench, BenchError, Cutoff, Film, Filter, Mode, Reconstruction, Weighting, rt_volume,
+    BenchError, Cutoff, Film, Filter, Mode, Reconstruction, SchlierenBench, Weighting, rt_volume,
 };
 use rt_volume::{Bounds, Constant, GaussianBump, IndexField};
 use support::{bench, knife};
 
 const SQRT_2PI: f64 = 2.506_628_274_631_000_5;
 
-fn sheet(mode: Mode, strata: u32) -> Bench {
-    Bench { reconstruction: Reconstruction::Sheet, ..bench(mode, strata) }
+fn sheet(mode: Mode, strata: u32) -> SchlierenBench {
+    SchlierenBench { reconstruction: Reconstruction::Sheet, ..bench(mode, strata) }
 }
 
-fn render(b: &Bench, f: &(impl IndexField + Sync), w: usize, h: usize, passes: u64) -> Film {
+fn render(
+    b: &SchlierenBench,
+    f: &(impl IndexField + Sync),
+    w: usize,
+    h: usize,
+    passes: u64,
+) -> Film {
     let mut film = Film::new(w, h, Filter::Box).unwrap();
     for pass in 0..passes {
         b.render(f, &mut film, pass, 11).unwrap();
@@ -77,7 +83,7 @@ fn undisturbed_beam_is_exactly_the_background() {
 fn light_is_conserved_through_folds() {
     let f = GaussianBump::new(DVec3::ZERO, 5e-3, 1.0, 2.9);
     for l in [0.0, 200.0] {
-        let b = Bench { film_distance: l, ..sheet(Mode::Schlieren(Cutoff::None), 2) };
+        let b = SchlierenBench { film_distance: l, ..sheet(Mode::Schlieren(Cutoff::None), 2) };
         let film = render(&b, &f, 40, 40, 2);
         let total = film.total()[0];
         let want = film.per_pixel * 1600.0;
@@ -86,7 +92,7 @@ fn light_is_conserved_through_folds() {
     }
     // At L = 200 the light really is rearranged: the focus is brighter
     // than the background several times over.
-    let b = Bench { film_distance: 200.0, ..sheet(Mode::Schlieren(Cutoff::None), 2) };
+    let b = SchlierenBench { film_distance: 200.0, ..sheet(Mode::Schlieren(Cutoff::None), 2) };
     let peak = render(&b, &f, 40, 40, 1).normalized_f64().iter().map(|p| p[0]).fold(0.0, f64::max);
     assert!(peak > 3.0, "peak {peak}");
 }
@@ -125,7 +131,7 @@ fn knife_edge_matches_the_analytic_gaussian_with_few_photons() {
 fn shadowgraph_matches_the_linearised_gaussian_with_few_photons() {
     let (delta, sigma, l) = (1e-4, 1.0, 100.0);
     let f = GaussianBump::new(DVec3::ZERO, delta, sigma, 5.0);
-    let b = Bench { film_distance: l, ..sheet(Mode::Schlieren(Cutoff::None), 4) };
+    let b = SchlierenBench { film_distance: l, ..sheet(Mode::Schlieren(Cutoff::None), 4) };
     let film = render(&b, &f, 32, 32, 1);
     let a = SQRT_2PI * delta / sigma;
     let want = |x: f64, y: f64| {
@@ -142,7 +148,7 @@ fn shadowgraph_matches_the_linearised_gaussian_with_few_photons() {
 #[test]
 fn deterministic_across_thread_counts() {
     let f = GaussianBump::new(DVec3::ZERO, 5e-3, 1.0, 5.0);
-    let b = Bench { film_distance: 150.0, ..sheet(knife(300.0), 2) };
+    let b = SchlierenBench { film_distance: 150.0, ..sheet(knife(300.0), 2) };
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
@@ -160,7 +166,7 @@ fn deterministic_across_thread_counts() {
 #[test]
 fn roulette_is_refused() {
     let f = GaussianBump::new(DVec3::ZERO, 1e-4, 1.0, 5.0);
-    let b = Bench { weighting: Weighting::Roulette, ..sheet(knife(1500.0), 2) };
+    let b = SchlierenBench { weighting: Weighting::Roulette, ..sheet(knife(1500.0), 2) };
     let mut film = Film::new(8, 8, Filter::Box).unwrap();
     assert_eq!(b.render(&f, &mut film, 0, 1), Err(BenchError::SheetRoulette));
     assert_eq!(film.emitted, 0);

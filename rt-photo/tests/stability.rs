@@ -7,7 +7,7 @@
 mod support;
 
 use glam::DVec3;
-use rt_photo::{Bench, Cutoff, Film, Filter, Mode};
+use rt_photo::{Cutoff, Film, Filter, Mode, SchlierenBench};
 use rt_volume::GaussianBump;
 
 fn filters() -> [Filter; 4] {
@@ -121,7 +121,7 @@ fn cutoffs_over_twenty_decades_of_deflection() {
 
 /// A beam along +z through `[-3, 3]²` with a knife edge, one photon per
 /// pixel.
-fn knife_bench(f_over_h: f64) -> Bench {
+fn knife_bench(f_over_h: f64) -> SchlierenBench {
     support::bench(support::knife(f_over_h), 1)
 }
 

@@ -167,12 +167,12 @@ pub fn bend(g: f64) -> f64 {
 pub fn schlieren(delta: f64, eps: f64) -> f64 {
     use rt_photo::glam::DVec3;
     use rt_photo::rt_volume::GaussianBump;
-    use rt_photo::{Bench, Cutoff, Film, Filter, Mode, Reconstruction, TraceParams, Weighting};
+    use rt_photo::{SchlierenBench, Cutoff, Film, Filter, Mode, Reconstruction, TraceParams, Weighting};
     let edge = Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.0, h: 1e-3 };
     if edge.validate().is_err() {
         return f64::NAN;
     }
-    let bench = Bench {
+    let bench = SchlierenBench {
         center: DVec3::new(0.0, 0.0, -6.0),
         direction: DVec3::Z,
         u: DVec3::X,

@@ -96,7 +96,7 @@ pub enum BenchError {
     /// carries each cell's mean transmission, never a random 0 or 1.
     SheetRoulette,
     /// Tracing a photon failed (or building the beam mask of
-    /// [`Bench::render_medium`] on a grid).
+    /// [`SchlierenBench::render_medium`] on a grid).
     Trace(TraceError),
 }
 
@@ -158,7 +158,7 @@ impl From<TraceError> for BenchError {
 
 /// A collimated beam, the optics behind the test section, and the film.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Bench {
+pub struct SchlierenBench {
     /// Centre of the beam's emission plane (upstream of the field).
     pub center: DVec3,
     /// Beam direction (unit).
@@ -219,7 +219,7 @@ fn r2(n: u64, shift: (f64, f64)) -> (f64, f64) {
     (frac(shift.0 + frac(n * A1)), frac(shift.1 + frac(n * A2)))
 }
 
-impl Bench {
+impl SchlierenBench {
     fn v(&self) -> DVec3 {
         self.direction.cross(self.u)
     }
@@ -404,10 +404,10 @@ impl Bench {
         resolvable.min(1e-3)
     }
 
-    /// [`Bench::render`] for a gridded field on the fast path
-    /// ([`Bench::render_medium`] of a grid): the octree `tree` lets photons
+    /// [`SchlierenBench::render`] for a gridded field on the fast path
+    /// ([`SchlierenBench::render_medium`] of a grid): the octree `tree` lets photons
     /// cross the field's smooth regions in straight steps, with the
-    /// tolerance the bench cannot resolve ([`Bench::skip_tolerance`]);
+    /// tolerance the bench cannot resolve ([`SchlierenBench::skip_tolerance`]);
     /// photons whose line meets no node too rough for it (a [`BeamMask`]
     /// with one cell per film pixel) go straight without walking the tree.
     /// With a tree built for another interpolant, traced without skipping.
@@ -436,12 +436,12 @@ impl Bench {
         self.render_with(&|o, d| trace_beam(field, tree, &mask, o, d, params), film, pass, seed)
     }
 
-    /// [`Bench::render`] with any tracer `(origin, direction) → result`,
+    /// [`SchlierenBench::render`] with any tracer `(origin, direction) → result`,
     /// e.g. octree skipping over a gridded field:
     /// `|o, d| rt_volume::trace_skipping(&grid, &tree, o, d, &params, tol)`.
     ///
     /// # Errors
-    /// As [`Bench::render`].
+    /// As [`SchlierenBench::render`].
     pub fn render_with(
         &self,
         tracer: &(impl Fn(DVec3, DVec3) -> Result<TraceResult, TraceError> + Sync),
@@ -458,7 +458,7 @@ impl Bench {
     /// Photons that miss the volume carry white.
     ///
     /// # Errors
-    /// As [`Bench::render`].
+    /// As [`SchlierenBench::render`].
     pub fn render_colored<F: IndexField + Sync>(
         &self,
         field: &F,

@@ -112,7 +112,7 @@ impl BosSetup {
         let ext = b.max - b.min;
         let (w, h) = o.axis.image_size(b, o.size as usize);
         let deflection = if o.rig.background_distance.is_none() {
-            let probe = crate::Bench::through(
+            let probe = crate::SchlierenBench::through(
                 b,
                 o.axis,
                 Mode::Schlieren(Cutoff::None),

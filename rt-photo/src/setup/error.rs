@@ -35,7 +35,7 @@ pub enum SetupError {
     /// The survey's or the render's film could not be made.
     Film(FilmError),
     /// The bench (or its survey) failed.
-    Bench(BenchError),
+    SchlierenBench(BenchError),
     /// The BOS rig or render failed.
     Bos(BosError),
     /// The focusing rig or render failed.
@@ -56,7 +56,7 @@ impl fmt::Display for SetupError {
                 "the volume must be farther from the lens ({distance} m) than its focal length ({focal_length} m)"
             ),
             Self::Film(e) => e.fmt(f),
-            Self::Bench(e) => e.fmt(f),
+            Self::SchlierenBench(e) => e.fmt(f),
             Self::Bos(e) => e.fmt(f),
             Self::Focusing(e) => e.fmt(f),
         }
@@ -67,7 +67,7 @@ impl core::error::Error for SetupError {
     fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
         match self {
             Self::Film(e) => Some(e),
-            Self::Bench(e) => Some(e),
+            Self::SchlierenBench(e) => Some(e),
             Self::Bos(e) => Some(e),
             Self::Focusing(e) => Some(e),
             _ => None,
@@ -83,7 +83,7 @@ impl From<FilmError> for SetupError {
 
 impl From<BenchError> for SetupError {
     fn from(e: BenchError) -> Self {
-        Self::Bench(e)
+        Self::SchlierenBench(e)
     }
 }
 

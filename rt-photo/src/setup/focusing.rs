@@ -91,7 +91,7 @@ impl FocusingSetup {
         let (w, h) = o.axis.image_size(b, o.size as usize);
         let angle = o.angle.to_radians();
         let deflection = if o.rig.grid_pitch.is_none() {
-            let probe = crate::Bench::through(
+            let probe = crate::SchlierenBench::through(
                 b,
                 o.axis,
                 Mode::Schlieren(Cutoff::None),

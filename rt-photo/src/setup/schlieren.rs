@@ -8,7 +8,8 @@ use rt_volume::Medium;
 
 use super::error::{finite, positive, within};
 use crate::{
-    Axis, Bench, Cutoff, Film, Filter, FilterImage, Mode, Reconstruction, SetupError, Survey,
+    Axis, Cutoff, Film, Filter, FilterImage, Mode, Reconstruction, SchlierenBench, SetupError,
+    Survey,
     units::{index, si, sig3},
 };
 
@@ -122,7 +123,7 @@ impl SchlierenOptions {
 #[derive(Clone, Debug)]
 pub struct SchlierenSetup {
     /// The bench, with the chosen optics.
-    pub bench: Bench,
+    pub bench: SchlierenBench,
     /// Film width and height in pixels.
     pub size: (usize, usize),
     /// Photons per pixel asked for.
@@ -143,8 +144,13 @@ impl SchlierenSetup {
     pub fn choose(medium: &Medium, o: &SchlierenOptions) -> Result<Self, SetupError> {
         o.validate()?;
         let params = medium.params();
-        let probe =
-            Bench::through(medium.bounds(), o.axis, Mode::Schlieren(Cutoff::None), 0.0, params);
+        let probe = SchlierenBench::through(
+            medium.bounds(),
+            o.axis,
+            Mode::Schlieren(Cutoff::None),
+            0.0,
+            params,
+        );
         let (w, h) = o.axis.image_size(medium.bounds(), o.size as usize);
         let photons = w as u64 * h as u64 * traced_per_pixel(o.photons);
         if photons > MAX_PHOTONS {
@@ -172,9 +178,9 @@ impl SchlierenSetup {
                     Some(format!("fringes alias: up to {step:.1} rad of phase per pixel (> π)"));
             }
         }
-        let bench = Bench {
+        let bench = SchlierenBench {
             reconstruction: o.reconstruction,
-            ..Bench::through(medium.bounds(), o.axis, mode, film_distance, params)
+            ..SchlierenBench::through(medium.bounds(), o.axis, mode, film_distance, params)
         };
         Ok(Self { bench, size: (w, h), photons: o.photons, options: o.clone(), warning })
     }
@@ -194,7 +200,7 @@ impl SchlierenSetup {
         let (w, h) = self.size;
         let mut film = Film::new(w, h, Filter::Tent)?;
         let (strata, passes) = lattice(self.photons);
-        let bench = Bench { strata, ..self.bench.clone() };
+        let bench = SchlierenBench { strata, ..self.bench.clone() };
         let per_pass = (w * h) as u64 * u64::from(strata * strata);
         for pass in 0..passes {
             bench.render_medium(medium, &mut film, pass, seed)?;

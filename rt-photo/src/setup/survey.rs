@@ -5,7 +5,7 @@ use alloc::vec::Vec;
 
 use rt_volume::Medium;
 
-use crate::{Bench, Cutoff, Film, Filter, Mode, SetupError, math};
+use crate::{Cutoff, Film, Filter, Mode, SchlierenBench, SetupError, math};
 
 /// Mean deflection per pixel of a coarse, uncut image of a medium.
 #[derive(Clone, Debug)]
@@ -31,12 +31,15 @@ impl Survey {
     ///
     /// # Errors
     /// A failing trace.
-    pub fn of(medium: &Medium, bench: &Bench, width: usize) -> Result<Self, SetupError> {
+    pub fn of(medium: &Medium, bench: &SchlierenBench, width: usize) -> Result<Self, SetupError> {
         let width = width.max(1);
         let height = math::round(width as f64 * bench.height / bench.width).clamp(1.0, 4096.0);
         let mut film = Film::new(width, height as usize, Filter::Box)?;
-        let probe =
-            Bench { mode: Mode::Schlieren(Cutoff::None), film_distance: 0.0, ..bench.clone() };
+        let probe = SchlierenBench {
+            mode: Mode::Schlieren(Cutoff::None),
+            film_distance: 0.0,
+            ..bench.clone()
+        };
         probe.probe_medium(medium, &mut film)?;
         Ok(Self {
             eps: film.mean_deflection(),

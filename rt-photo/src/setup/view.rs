@@ -3,7 +3,7 @@
 use glam::DVec3;
 use rt_volume::{Bounds, TraceParams};
 
-use crate::{Bench, Mode, Reconstruction, Weighting};
+use crate::{Mode, Reconstruction, SchlierenBench, Weighting};
 
 /// The coordinate axis a beam or camera looks along.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -40,7 +40,7 @@ impl Axis {
     }
 }
 
-impl Bench {
+impl SchlierenBench {
     /// A bench looking through the box `b` along `axis`: the beam covers
     /// the box's cross-section and starts upstream of it; the optics image
     /// the box's mid-plane, the film sits `film_distance` behind it

@@ -2,12 +2,12 @@
 #![allow(dead_code, reason = "each test binary uses only part of it")]
 
 use rt_photo::glam::DVec3;
-use rt_photo::{Bench, Cutoff, Mode, Reconstruction, TraceParams, Weighting};
+use rt_photo::{Cutoff, Mode, Reconstruction, SchlierenBench, TraceParams, Weighting};
 
 /// A beam along +z over `[-3, 3]²`, emitted at z = −6, imaging the plane
 /// z = 0 (`L = 0`), `strata²` photons per pixel, weighted.
-pub(crate) fn bench(mode: Mode, strata: u32) -> Bench {
-    Bench {
+pub(crate) fn bench(mode: Mode, strata: u32) -> SchlierenBench {
+    SchlierenBench {
         center: DVec3::new(0.0, 0.0, -6.0),
         direction: DVec3::Z,
         u: DVec3::X,

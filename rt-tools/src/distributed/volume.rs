@@ -45,7 +45,7 @@ use rt_composite::{
     Communicator,
     exchange::{ExchangeStats, all_gather, rounds},
 };
-use rt_photo::{Axis, Bench, Cutoff, Film, Filter, Mode, Reconstruction, Weighting};
+use rt_photo::{Axis, Cutoff, Film, Filter, Mode, Reconstruction, SchlierenBench, Weighting};
 use rt_volume::{
     Begin, BrickField, Bricks, Exit, Grid, GridField, GridInfo, Interp, Leg, PathState, Samples,
     TraceParams, TraceResult, TraceStats, glam::DVec3, io, step_reach, trace, trace_begin,
@@ -172,7 +172,7 @@ impl VolumeJob {
 
     /// The bench through the volume along z, in the mode's optics (the
     /// knife edge's range comes later, from the photons).
-    fn bench(&self, info: &GridInfo, ambient: f64, h: f64) -> Bench {
+    fn bench(&self, info: &GridInfo, ambient: f64, h: f64) -> SchlierenBench {
         let mode = match self.optics {
             VolumeOptics::Knife => {
                 Mode::Schlieren(Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.0, h })
@@ -181,8 +181,8 @@ impl VolumeJob {
                 Mode::Interferometry { lambda, n_ref: ambient, fringe_spacing: fringes }
             }
         };
-        let bench = Bench::through(info.bounds(), Axis::Z, mode, 0.0, Self::params(info));
-        Bench {
+        let bench = SchlierenBench::through(info.bounds(), Axis::Z, mode, 0.0, Self::params(info));
+        SchlierenBench {
             strata: self.strata,
             weighting: Weighting::Weight,
             reconstruction: Reconstruction::Sheet,
@@ -192,7 +192,7 @@ impl VolumeJob {
 
     /// The film, refusing more photons than [`MAX_PHOTONS`] (every rank
     /// lists their identities once).
-    fn film(&self, bench: &Bench) -> anyhow::Result<Film> {
+    fn film(&self, bench: &SchlierenBench) -> anyhow::Result<Film> {
         let height = (f64::from(self.size) * bench.height / bench.width).round().max(1.0) as usize;
         let side = |n: usize| (n as u64).saturating_mul(u64::from(self.strata)).saturating_add(2);
         let photons = side(self.size as usize).saturating_mul(side(height));
@@ -232,7 +232,7 @@ fn key(o: DVec3, d: DVec3) -> Key {
 }
 
 /// The photons the bench emits for `film`, each once, by key.
-fn emissions(bench: &Bench, film: &Film, seed: u64) -> anyhow::Result<Vec<Key>> {
+fn emissions(bench: &SchlierenBench, film: &Film, seed: u64) -> anyhow::Result<Vec<Key>> {
     let seen = Mutex::new(Vec::new());
     let mut scratch = Film::new(film.width(), film.height(), Filter::Tent)?;
     bench.render_with(
@@ -267,7 +267,7 @@ fn unkey(k: &Key) -> (DVec3, DVec3) {
 
 /// The knife edge's range from the photons' deflections along u: 0.5 ±
 /// 0.45 at their 99th percentile (f = 1 m).
-fn knife_range(bench: &Bench, results: &[TraceResult]) -> f64 {
+fn knife_range(bench: &SchlierenBench, results: &[TraceResult]) -> f64 {
     let mut along: Vec<f64> = results.iter().map(|r| r.direction.dot(bench.u).abs()).collect();
     along.sort_unstable_by(f64::total_cmp);
     let q = along.get((0.99 * (along.len().saturating_sub(1)) as f64) as usize).copied();
@@ -275,7 +275,7 @@ fn knife_range(bench: &Bench, results: &[TraceResult]) -> f64 {
 }
 
 /// One process tracing the whole grid: the reference the distributed
-/// image must equal. The film is `Bench::render`'s own.
+/// image must equal. The film is `SchlierenBench::render`'s own.
 ///
 /// # Errors
 /// An unreadable volume, a failing trace.

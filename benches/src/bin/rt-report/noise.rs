@@ -19,7 +19,8 @@ use rt_benches::{
     scenes::{knife_bench, sparse_bumps},
 };
 use rt_photo::{
-    Bench, Film, Filter, Reconstruction, SchlierenOptions, SchlierenSetup, TraceParams, lattice,
+    Film, Filter, Reconstruction, SchlierenBench, SchlierenOptions, SchlierenSetup, TraceParams,
+    lattice,
 };
 use rt_photo::{GridMedium, Medium};
 use rt_tools::builtin::blast_wave;
@@ -84,7 +85,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
         let height = ((size as f64) * bench.height / bench.width).round().max(1.0) as usize;
         let mut film = Film::new(size, height, Filter::Box).map_err(|e| e.to_string())?;
         let (strata, passes) = lattice(reference_n);
-        let b = Bench { strata, reconstruction: Reconstruction::Photons, ..bench.clone() };
+        let b = SchlierenBench { strata, reconstruction: Reconstruction::Photons, ..bench.clone() };
         for pass in 0..passes {
             b.render_medium(&volume, &mut film, pass, seed).map_err(|e| e.to_string())?;
         }
@@ -116,7 +117,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let mut rows = Vec::new();
     let height = ((size as f64) * bench.height / bench.width).round().max(1.0) as usize;
     for sheet in [true, false] {
-        let b = Bench {
+        let b = SchlierenBench {
             reconstruction: if sheet { Reconstruction::Sheet } else { Reconstruction::Photons },
             ..bench.clone()
         };

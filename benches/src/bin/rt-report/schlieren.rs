@@ -1,6 +1,6 @@
 //! Knife-edge schlieren of a sparse 128³ gridded field: the original
 //! scheme (explicit Euler, one-voxel step, trilinear, no octree) against
-//! rt's default for grids (`Bench::render_medium` on a grid: leapfrog with octree
+//! rt's default for grids (`SchlierenBench::render_medium` on a grid: leapfrog with octree
 //! skipping at the bench's tolerance), at one and two voxels per step;
 //! image RMSE against a converged reference, over photon counts.
 
