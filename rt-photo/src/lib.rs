@@ -37,6 +37,7 @@
 //! | `std` | yes | float functions from std (here, in `rt-volume` and `rt-core`) |
 //! | `libm` | no | float functions from `libm` for `no_std` builds |
 //! | `parallel` | no | rows traced and films splatted with rayon (implies `std`); images stay bit-identical |
+//! | `distributed` | no | [`distributed`]: a grid's photons handed between bricks on the ranks of an `rt_composite::Communicator`, equal to one process bit for bit (implies `parallel`) |
 //! | `png` | no | [`BackgroundChoice::read_png`]: BOS background images from PNG files (implies `std`) |
 //! | `mesh` | no | multifield colour on unstructured meshes (`SchlierenBench::render_mesh_colored`); meshes on every instrument come through `render_medium` with `rt-volume`'s `mesh` (implies `std`) |
 //!
@@ -87,6 +88,8 @@ extern crate std;
 
 mod bos;
 mod camera;
+#[cfg(feature = "distributed")]
+pub mod distributed;
 mod focusing;
 mod math;
 mod medium;

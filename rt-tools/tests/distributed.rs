@@ -78,7 +78,7 @@ fn surfaces_with_shadows_and_ao_equal_one_process_bit_for_bit() {
 }
 
 fn volumes(job: &volume::VolumeJob, ranks: usize) -> (rt_photo::Film, Vec<volume::VolumeRank>) {
-    on_ranks(ranks, |c| volume::rank(c, job))
+    on_ranks(ranks, |c| Ok(volume::rank(c, job)?))
 }
 
 /// Knife-edge schlieren and interferometry of the blast wave, photons
@@ -89,7 +89,7 @@ fn volumes(job: &volume::VolumeJob, ranks: usize) -> (rt_photo::Film, Vec<volume
 fn volumes_equal_one_process_bit_for_bit_and_no_rank_holds_the_grid() {
     let dir =
         std::env::temp_dir().join(format!("rt-tools-test-distributed-{}", std::process::id()));
-    let knife = volume::VolumeJob::builtin(&dir, 40, 1).unwrap();
+    let knife = volume::builtin(&dir, 40, 1).unwrap();
     let fringes = volume::VolumeJob {
         optics: volume::VolumeOptics::Interferometry { lambda: 10.6e-6, fringes: Some(0.04) },
         interp: rt_volume::Interp::Trilinear,
@@ -178,7 +178,7 @@ impl rt_composite::Communicator for GoesSilent {
 #[test]
 fn a_rank_that_stops_answering_is_an_error_on_every_rank() {
     let dir = std::env::temp_dir().join(format!("rt-tools-test-silent-{}", std::process::id()));
-    let vjob = volume::VolumeJob::builtin(&dir, 32, 1).unwrap();
+    let vjob = volume::builtin(&dir, 32, 1).unwrap();
     let sjob = SurfaceJob {
         size: (64, 48),
         grid: 33,

@@ -113,9 +113,8 @@ fn surface_rows(quick: bool, ranks: &[usize], reps: usize) -> Result<Vec<Row>, S
 
 fn volume_rows(quick: bool, ranks: &[usize], reps: usize) -> Result<Vec<Row>, String> {
     let dir = std::env::temp_dir().join(format!("rt-report-distributed-{}", std::process::id()));
-    let job =
-        volume::VolumeJob::builtin(&dir, if quick { 128 } else { 512 }, if quick { 1 } else { 2 })
-            .map_err(|e| format!("{e:#}"))?;
+    let job = volume::builtin(&dir, if quick { 128 } else { 512 }, if quick { 1 } else { 2 })
+        .map_err(|e| format!("{e:#}"))?;
     let whole = volume::single(&job).map_err(|e| format!("{e:#}"))?;
     let mut rows = Vec::new();
     for &n in ranks {

@@ -1,0 +1,252 @@
+//! What a distributed volume render is, and one process rendering it
+//! whole (the reference every rank count must equal).
+
+use alloc::vec::Vec;
+use std::{path::PathBuf, sync::Mutex};
+
+use glam::DVec3;
+use rayon::prelude::*;
+use rt_composite::exchange::ExchangeStats;
+use rt_volume::{
+    Exit, Grid, GridField, GridInfo, Interp, MediumError, Samples, TraceParams, TraceResult,
+    TraceStats, io, trace,
+};
+
+use super::{
+    BATCH, DistributedError, MAX_PHOTONS,
+    wire::{Key, PHOTON_BYTES, RESULT_BYTES, key, unkey},
+};
+use crate::{Axis, Cutoff, Film, Filter, Mode, Reconstruction, SchlierenBench, Weighting};
+
+/// What a volume render records.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum VolumeOptics {
+    /// Knife-edge schlieren, edge along the image's v axis (deflections
+    /// along u are seen); the edge's range is chosen from the photons'
+    /// deflections (0.5 ± 0.45 at their 99th percentile).
+    Knife,
+    /// Interferometry against the undisturbed index.
+    Interferometry {
+        /// Wavelength in metres.
+        lambda: f64,
+        /// Carrier fringe spacing in metres (`None`: infinite fringe).
+        fringes: Option<f64>,
+    },
+}
+
+/// What to render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VolumeJob {
+    /// A raw + JSON volume or an NRRD volume with raw encoding (read a
+    /// brick at a time).
+    pub file: PathBuf,
+    /// What the samples are.
+    pub samples: Samples,
+    /// The interpolant.
+    pub interp: Interp,
+    /// What is recorded.
+    pub optics: VolumeOptics,
+    /// Film width in pixels (the height follows the volume's aspect).
+    pub size: u32,
+    /// `strata × strata` photons per pixel.
+    pub strata: u32,
+    /// Seed of the photons' placement.
+    pub seed: u64,
+    /// Most photons a rank advances, and most results it sends rank 0,
+    /// per round ([`BATCH`] by default).
+    pub batch: usize,
+}
+
+impl VolumeJob {
+    /// Knife-edge schlieren of `file`'s densities (air) along z with the
+    /// Catmull–Rom interpolant, [`BATCH`] photons a round, seed 1.
+    #[must_use]
+    pub fn knife_edge(file: PathBuf, size: u32, strata: u32) -> Self {
+        Self {
+            file,
+            samples: Samples::AIR,
+            interp: Interp::CatmullRom,
+            optics: VolumeOptics::Knife,
+            size,
+            strata,
+            seed: 1,
+            batch: BATCH,
+        }
+    }
+
+    /// The longest message a rank can send: one round's hand-offs to one
+    /// peer and, to rank 0, one round's results, with their counts and
+    /// the two-byte header. Whatever the photon count.
+    #[must_use]
+    pub fn largest_message(&self) -> usize {
+        let batch = self.batch.max(1);
+        2 + 8 + batch * PHOTON_BYTES + 8 + batch * RESULT_BYTES
+    }
+
+    /// The samples `lo..hi` of the file, as index.
+    pub(crate) fn read_box(
+        &self,
+        lo: [usize; 3],
+        hi: [usize; 3],
+    ) -> Result<Grid, DistributedError> {
+        let grid = io::read_grid_box(&self.file, lo, hi)?;
+        // Non-physical samples are the user's to judge here (the ranks
+        // read bricks, not the whole volume's range).
+        self.samples.grid_to_index(grid, true).map_err(|e| {
+            let path = self.file.clone();
+            DistributedError::Samples(MediumError::InFile {
+                path,
+                source: alloc::boxed::Box::new(e),
+            })
+        })
+    }
+
+    /// The whole grid's header, and the index outside the volume (its
+    /// first sample's, as a medium takes it).
+    pub(crate) fn header(&self) -> Result<(GridInfo, f64), DistributedError> {
+        let ext = self.file.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        if !matches!(ext.as_deref(), Some("json" | "raw" | "nrrd" | "nhdr")) {
+            return Err(DistributedError::Format(self.file.clone()));
+        }
+        let info = io::read_grid_info(&self.file)?;
+        let first = self.read_box([0; 3], [1; 3])?;
+        let ambient = f64::from(first.data()[0]);
+        Ok((info, ambient))
+    }
+
+    /// Step as `TraceParams::for_grid` takes it: leapfrog at one cell.
+    pub(crate) fn params(info: &GridInfo) -> TraceParams {
+        let cell = info.spacing.min_element();
+        TraceParams { max_step: cell, ..TraceParams::fixed(rt_volume::Method::Symplectic, cell) }
+    }
+
+    /// The bench through the volume along z, in the mode's optics (the
+    /// knife edge's range comes later, from the photons).
+    pub(crate) fn bench(&self, info: &GridInfo, ambient: f64, h: f64) -> SchlierenBench {
+        let mode = match self.optics {
+            VolumeOptics::Knife => {
+                Mode::Schlieren(Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.0, h })
+            }
+            VolumeOptics::Interferometry { lambda, fringes } => {
+                Mode::Interferometry { lambda, n_ref: ambient, fringe_spacing: fringes }
+            }
+        };
+        let bench = SchlierenBench::through(info.bounds(), Axis::Z, mode, 0.0, Self::params(info));
+        SchlierenBench {
+            strata: self.strata,
+            weighting: Weighting::Weight,
+            reconstruction: Reconstruction::Sheet,
+            ..bench
+        }
+    }
+
+    /// The film, refusing more photons than [`MAX_PHOTONS`] (every rank
+    /// lists their identities once).
+    pub(crate) fn film(&self, bench: &SchlierenBench) -> Result<Film, DistributedError> {
+        let height = (f64::from(self.size) * bench.height / bench.width).round().max(1.0) as usize;
+        let side = |n: usize| (n as u64).saturating_mul(u64::from(self.strata)).saturating_add(2);
+        let photons = side(self.size as usize).saturating_mul(side(height));
+        if photons > MAX_PHOTONS {
+            return Err(DistributedError::TooManyPhotons { photons, max: MAX_PHOTONS });
+        }
+        Ok(Film::new(self.size as usize, height, Filter::Tent)?)
+    }
+}
+
+/// What one rank did, and what it cost.
+#[derive(Clone, Debug, Default)]
+pub struct VolumeRank {
+    /// Samples of this rank's brick (ghost layers included).
+    pub brick_samples: usize,
+    /// Samples of the whole grid.
+    pub grid_samples: usize,
+    /// Photons that entered the volume in this rank's brick.
+    pub entered: u64,
+    /// Legs traced here (a photon crossing three bricks has three legs).
+    pub legs: u64,
+    /// Photons this rank handed to another.
+    pub handed_off: u64,
+    /// The rounds' messages and bytes (hand-offs and results).
+    pub exchange: ExchangeStats,
+    /// Seconds: reading the brick, tracing (rounds), the film (rank 0).
+    pub seconds: [f64; 3],
+}
+
+/// The photons the bench emits for `film`, each once, by key.
+pub(crate) fn emissions(
+    bench: &SchlierenBench,
+    film: &Film,
+    seed: u64,
+) -> Result<Vec<Key>, DistributedError> {
+    let seen = Mutex::new(Vec::new());
+    let mut scratch = Film::new(film.width(), film.height(), Filter::Tent)?;
+    bench.render_with(
+        &|o, d| {
+            seen.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push(key(o, d));
+            Ok(straight(o, d))
+        },
+        &mut scratch,
+        0,
+        seed,
+    )?;
+    let mut keys = seen.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner);
+    keys.sort_unstable();
+    keys.dedup();
+    Ok(keys)
+}
+
+/// A photon that went straight, nothing done.
+fn straight(o: DVec3, d: DVec3) -> TraceResult {
+    TraceResult {
+        position: o,
+        direction: d,
+        optical_path: 0.0,
+        exit: Exit::Missed,
+        stats: TraceStats::default(),
+    }
+}
+
+/// The knife edge's range from the photons' deflections along u: 0.5 ±
+/// 0.45 at their 99th percentile (f = 1 m).
+pub(crate) fn knife_range(bench: &SchlierenBench, results: &[TraceResult]) -> f64 {
+    let mut along: Vec<f64> = results.iter().map(|r| r.direction.dot(bench.u).abs()).collect();
+    along.sort_unstable_by(f64::total_cmp);
+    let q = along.get((0.99 * (along.len().saturating_sub(1)) as f64) as usize).copied();
+    q.unwrap_or(0.0).max(1e-12) / 0.45
+}
+
+/// One process tracing the whole grid: the reference the distributed
+/// image must equal. The film is `SchlierenBench::render`'s own.
+///
+/// # Errors
+/// An unreadable volume, a failing trace.
+pub fn single(job: &VolumeJob) -> Result<Film, DistributedError> {
+    let (info, ambient) = job.header()?;
+    let whole = job.read_box([0; 3], info.dims)?;
+    let field = GridField::new(whole, job.interp, ambient)?;
+    let bench = job.bench(&info, ambient, 1.0);
+    let mut film = job.film(&bench)?;
+    let bench = if job.optics == VolumeOptics::Knife {
+        let keys = emissions(&bench, &film, job.seed)?;
+        let results = keys
+            .par_iter()
+            .map(|k| {
+                let (o, d) = unkey(k);
+                trace(&field, o, d, &bench.params)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        job.bench(&info, ambient, knife_range(&bench, &results))
+    } else {
+        bench
+    };
+    bench.render(&field, &mut film, 0, job.seed)?;
+    Ok(film)
+}
+
+/// Whether two films hold the same image, bit for bit.
+#[must_use]
+pub fn same(a: &Film, b: &Film) -> bool {
+    let bits =
+        |f: &Film| -> Vec<u32> { f.normalized().iter().flatten().map(|v| v.to_bits()).collect() };
+    a.width() == b.width() && a.height() == b.height() && bits(a) == bits(b)
+}
