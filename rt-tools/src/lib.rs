@@ -15,8 +15,9 @@
 //! - [`builtin`]: the built-in blast wave (a real PyClaw solution, 64³)
 //!   as a medium, a mesh or files; [`scenes`]: the demo's terrain;
 //! - [`distributed`]: a terrain (shadow and AO rays answered by every
-//!   rank) or a volume (photons handed between bricks) rendered across
-//!   ranks and checked against one process bit for bit.
+//!   rank) rendered across ranks and checked against one process bit for
+//!   bit; volumes (photons handed between bricks) are
+//!   `rt_photo::distributed`'s.
 //!
 //! Not a stable API: it changes with the tools (it is packaged only
 //! because the `rt` program depends on it).
