@@ -59,11 +59,12 @@ def test_strided_and_fortran_arrays_are_read_in_logical_order():
 
 
 def test_bad_optics(vol):
-    with pytest.raises(ValueError, match="cutoff: unknown 'knif'"):
+    # The library's set-up checks the options (once); its messages.
+    with pytest.raises(ValueError, match="cutoff: unknown `knif`"):
         rtvis.schlieren(vol, cutoff="knif")
     with pytest.raises(TypeError, match="unexpected keyword argument 'focal'"):
         rtvis.schlieren(vol, focal=1.0)
-    with pytest.raises(ValueError, match="f must be > 0"):
+    with pytest.raises(ValueError, match=r"f must be finite and > 0 \(got 0\)"):
         rtvis.schlieren(vol, f=0.0)
     with pytest.raises(ValueError, match="angle must be finite"):
         rtvis.schlieren(vol, angle=float("nan"))
@@ -73,9 +74,9 @@ def test_bad_optics(vol):
         rtvis.schlieren(vol, size=12.5)
     with pytest.raises(ValueError, match="photons must be 1 to 65536"):
         rtvis.shadowgraph(vol, photons=10**6)
-    with pytest.raises(ValueError, match="axis: unknown 'w'"):
+    with pytest.raises(ValueError, match="axis: unknown `w`"):
         rtvis.interferogram(vol, axis="w")
-    with pytest.raises(ValueError, match="wavelength must be > 0"):
+    with pytest.raises(ValueError, match="wavelength must be finite and > 0"):
         rtvis.interferogram(vol, wavelength=-1.0)
     with pytest.raises(TypeError, match="volume: expected an rtvis.Volume"):
         rtvis.schlieren(np.ones((3, 3, 3)))

@@ -222,7 +222,7 @@ def test_bos_displacement_is_the_paraxial_relation(gaussian):
     assert np.abs(disp2).max() < 1e-9 and np.abs(flow2 - ref2).max() < 1e-9
     with pytest.raises(ValueError, match="farther from the lens"):
         rtvis.bos(vol, focal_length=0.1, distance=0.05)
-    with pytest.raises(ValueError, match="f_number must be > 0"):
+    with pytest.raises(ValueError, match="f_number must be finite and > 0"):
         rtvis.bos(vol, f_number=-1)
 
 
@@ -264,7 +264,7 @@ def test_bos_backgrounds_and_diffraction(tmp_path):
     (tmp_path / "junk.png").write_bytes(b"not a png")
     with pytest.raises(ValueError, match="junk.png"):
         rtvis.bos(flat, size=8, background=str(tmp_path / "junk.png"))
-    with pytest.raises(ValueError, match="background_pixel must be > 0"):
+    with pytest.raises(ValueError, match="background_pixel must be finite and > 0"):
         rtvis.bos(flat, size=8, background=img, background_pixel=0.0)
     with pytest.raises(ValueError, match="airy pixel must be > 0"):
         rtvis.record(grid, airy=(532e-9, 16.0, 0.0))

@@ -106,6 +106,9 @@ impl BosSetup {
         ] {
             v.map(|v| positive(name, v)).transpose()?;
         }
+        if let BackgroundChoice::Image { pixel: Some(px), .. } = &o.background {
+            positive("background_pixel", *px)?;
+        }
         let b = medium.bounds();
         let (axis, u) = o.axis.frame();
         let v = axis.cross(u);

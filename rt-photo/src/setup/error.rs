@@ -119,6 +119,6 @@ pub(crate) fn within(name: &'static str, v: u32, lo: u32, hi: u32) -> Result<u32
 }
 
 /// An [`SetupError::Invalid`].
-fn invalid(name: &'static str, must_be: &str, got: impl fmt::Display) -> SetupError {
+pub(crate) fn invalid(name: &'static str, must_be: &str, got: impl fmt::Display) -> SetupError {
     SetupError::Invalid { name, must_be: must_be.into(), got: alloc::format!("{got}") }
 }

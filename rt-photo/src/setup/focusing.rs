@@ -3,7 +3,7 @@
 
 use rt_volume::Medium;
 
-use super::error::{finite, positive, within};
+use super::error::{finite, invalid, positive, within};
 use crate::{
     Axis, Cutoff, FocusingImages, FocusingRig, FocusingRigOptions, FocusingSchlieren, Mode,
     SetupError, SourceGrid, Survey, ThinLens,
@@ -73,6 +73,15 @@ impl FocusingSetup {
         within("samples", o.samples_per_axis, 1, 64)?;
         finite("focus", o.focus)?;
         finite("angle", o.angle)?;
+        if !(o.duty > 0.0 && o.duty < 1.0) {
+            return Err(invalid("duty", "in (0, 1)", o.duty));
+        }
+        if !(o.offset >= 0.0 && o.offset < 1.0) {
+            return Err(invalid("offset", "in [0, 1) pitches", o.offset));
+        }
+        if let Some(n) = o.bands {
+            within("bands", n, 1, u32::MAX)?;
+        }
         let r = &o.rig;
         for (name, v) in [
             ("focal_length", r.focal_length),

@@ -8,7 +8,7 @@ from typing import Optional, Union
 import numpy as np
 
 from . import _rtvis
-from ._checks import _array, _choice, _integer, _number
+from ._checks import _array, _float, _str, _uint
 from ._volume import Mesh, Volume
 
 
@@ -64,18 +64,18 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
             raise ValueError(f"background: value at {where} is negative ({image[where]})")
     return _rtvis._bos(
         volume._v,
-        _choice("axis", axis, ("x", "y", "z")),
-        _integer("size", size, 1, 8192),
-        _number("focal_length", focal_length, positive=True, optional=True),
-        _number("f_number", f_number, positive=True),
-        _number("pixel", pixel, positive=True, optional=True),
-        _number("distance", distance, positive=True, optional=True),
-        _number("background_distance", background_distance, positive=True, optional=True),
-        _number("dot", dot, positive=True),
-        _number("spacing", spacing, positive=True),
-        _integer("samples", samples, 1, 64),
-        _integer("seed", seed, 0, 2**64 - 1),
+        _str("axis", axis),
+        _uint("size", size),
+        _float("focal_length", focal_length, optional=True),
+        _float("f_number", f_number),
+        _float("pixel", pixel, optional=True),
+        _float("distance", distance, optional=True),
+        _float("background_distance", background_distance, optional=True),
+        _float("dot", dot),
+        _float("spacing", spacing),
+        _uint("samples", samples),
+        _uint("seed", seed, 64),
         name,
         image,
-        _number("background_pixel", background_pixel, positive=True, optional=True),
+        _float("background_pixel", background_pixel, optional=True),
     )

@@ -31,6 +31,30 @@ def _number(name: str, value, *, positive: bool = False, optional: bool = False)
     return v
 
 
+def _float(name: str, value, *, optional: bool = False) -> Optional[float]:
+    """``value`` as a float, its type checked only: the native half's
+    set-ups check ranges (NaN and infinities included), once."""
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name}: expected a number, got {type(value).__name__}")
+    return float(value)
+
+
+def _str(name: str, value) -> str:
+    """``value`` as a str, its type checked only (the native half knows
+    the names)."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name}: expected a str, got {type(value).__name__}")
+    return value
+
+
+def _uint(name: str, value, bits: int = 32) -> int:
+    """``value`` as an int in the native type's domain; the native half
+    checks its range."""
+    return _integer(name, value, 0, 2**bits - 1)
+
+
 def _integer(name: str, value, lo: int, hi: int) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise TypeError(f"{name}: expected an int, got {type(value).__name__}")

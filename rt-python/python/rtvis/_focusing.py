@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Optional, Union
 
 from . import _rtvis
-from ._checks import _choice, _integer, _number
+from ._checks import _float, _str, _uint
 from ._volume import Mesh, Volume
 
 
@@ -80,27 +80,21 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
     """
     if not isinstance(volume, (Volume, Mesh)):
         raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
-    duty = _number("duty", duty)
-    if not 0.0 < duty < 1.0:
-        raise ValueError(f"duty must be in (0, 1) (got {duty})")
-    offset = _number("offset", offset)
-    if not 0.0 <= offset < 1.0:
-        raise ValueError(f"offset must be in [0, 1) pitches (got {offset})")
     return _rtvis._focusing(
         volume._v,
-        _choice("axis", axis, ("x", "y", "z")),
-        _integer("size", size, 1, 8192),
-        _number("focal_length", focal_length, positive=True, optional=True),
-        _number("aperture", aperture, positive=True, optional=True),
-        _number("pixel", pixel, positive=True, optional=True),
-        _number("distance", distance, positive=True, optional=True),
-        _number("focus", focus),
-        _number("source_distance", source_distance, positive=True, optional=True),
-        _number("pitch", pitch, positive=True, optional=True),
-        duty,
-        _number("angle", angle),
-        offset,
-        None if bands is None else _integer("bands", bands, 1, 2**32 - 1),
-        _integer("samples", samples, 1, 64),
-        _integer("seed", seed, 0, 2**64 - 1),
+        _str("axis", axis),
+        _uint("size", size),
+        _float("focal_length", focal_length, optional=True),
+        _float("aperture", aperture, optional=True),
+        _float("pixel", pixel, optional=True),
+        _float("distance", distance, optional=True),
+        _float("focus", focus),
+        _float("source_distance", source_distance, optional=True),
+        _float("pitch", pitch, optional=True),
+        _float("duty", duty),
+        _float("angle", angle),
+        _float("offset", offset),
+        None if bands is None else _uint("bands", bands),
+        _uint("samples", samples),
+        _uint("seed", seed, 64),
     )

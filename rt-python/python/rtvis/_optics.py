@@ -9,7 +9,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from . import _rtvis
-from ._checks import _array, _choice, _integer, _number
+from ._checks import _array, _float, _integer, _number, _str, _uint
 from ._volume import Mesh, Volume
 
 
@@ -21,19 +21,19 @@ def _bench(volume, cutoff, *, angle=0.0, f=1.0, h=None, radius=None, half_range=
     *out, warning = _rtvis._optics(
         volume._v,
         cutoff,
-        _number("angle", angle),
-        _number("f", f, positive=True),
-        _number("h", h, positive=True, optional=True),
-        _number("radius", radius, positive=True, optional=True),
-        _number("half_range", half_range, positive=True, optional=True),
-        _number("wavelength", wavelength, positive=True),
-        _number("fringe_spacing", fringe_spacing, positive=True, optional=True),
-        _number("film_distance", film_distance, optional=True),
-        _choice("axis", axis, ("x", "y", "z")),
-        _integer("size", size, 1, 16384),
-        _integer("photons", photons, 1, 65536),
-        _integer("seed", seed, 0, 2**64 - 1),
-        _choice("estimator", estimator, ("sheet", "photons")),
+        _float("angle", angle),
+        _float("f", f),
+        _float("h", h, optional=True),
+        _float("radius", radius, optional=True),
+        _float("half_range", half_range, optional=True),
+        _float("wavelength", wavelength),
+        _float("fringe_spacing", fringe_spacing, optional=True),
+        _float("film_distance", film_distance, optional=True),
+        _str("axis", axis),
+        _uint("size", size),
+        _uint("photons", photons),
+        _uint("seed", seed, 64),
+        _str("estimator", estimator),
     )
     if warning is not None:
         import warnings
@@ -140,7 +140,7 @@ def schlieren(
     The same options and seed give the same image as ``rt schlieren``.
     """
     image, eps, _, background, _ = _bench(
-        volume, _choice("cutoff", cutoff, _CUTOFFS), angle=angle, f=f, h=h, radius=radius,
+        volume, _str("cutoff", cutoff), angle=angle, f=f, h=h, radius=radius,
         half_range=half_range, film_distance=film_distance, axis=axis, size=size,
         photons=photons, seed=seed, estimator=estimator,
     )
