@@ -37,7 +37,8 @@ fuzz_target!(|data: &[u8]| {
         images.push(img);
     }
     let over = u.ratio(1u8, 3).unwrap_or(false);
-    let mode = if over { Operator::Over { order: (0..n).rev().collect() } } else { Operator::Depth };
+    let mode =
+        if over { Operator::Over { order: (0..n).rev().collect() } } else { Operator::Depth };
     let schedule = if over { Schedule::DirectSend } else { schedule };
     if bad {
         images[n - 1].pop();

@@ -126,8 +126,7 @@ pub fn shade(bytes: &[u8], eye: [f32; 3]) -> f32 {
     use rt_surface::{Light, Renderer, Settings};
     let Ok(bvh) = BvhRef::<TriPacket>::from_bytes(bytes) else { return -1.0 };
     let projection = Projection::Perspective { fov_y: 0.8 };
-    let Ok(camera) = Camera::look_at(Vec3::from(eye), Vec3::ZERO, Vec3::Y, projection, 4, 4)
-    else {
+    let Ok(camera) = Camera::look_at(Vec3::from(eye), Vec3::ZERO, Vec3::Y, projection, 4, 4) else {
         return -1.0;
     };
     let settings = Settings {
@@ -167,7 +166,9 @@ pub fn bend(g: f64) -> f64 {
 pub fn schlieren(delta: f64, eps: f64) -> f64 {
     use rt_photo::glam::DVec3;
     use rt_photo::rt_volume::GaussianBump;
-    use rt_photo::{SchlierenBench, Cutoff, Film, Filter, Mode, Reconstruction, TraceParams, Weighting};
+    use rt_photo::{
+        Cutoff, Film, Filter, Mode, Reconstruction, SchlierenBench, TraceParams, Weighting,
+    };
     let edge = Cutoff::KnifeEdge { angle: 0.0, offset: 0.0, f: 1.0, h: 1e-3 };
     if edge.validate().is_err() {
         return f64::NAN;
@@ -208,7 +209,9 @@ pub fn auto_knife(excess: f32) -> f64 {
     use rt_photo::rt_volume::{Grid, Interp};
     use rt_photo::{Cutoff, Medium, Mode, Samples, SchlierenOptions, SchlierenSetup};
     let data: Vec<f32> = (0..512).map(|i| if i == 292 { 1.2 + excess } else { 1.2 }).collect();
-    let Ok(grid) = Grid::new([8; 3], DVec3::ZERO, DVec3::splat(1e-3), data) else { return f64::NAN };
+    let Ok(grid) = Grid::new([8; 3], DVec3::ZERO, DVec3::splat(1e-3), data) else {
+        return f64::NAN;
+    };
     let Ok(medium) = Medium::from_grid(grid, Samples::AIR, false, Interp::Trilinear) else {
         return f64::NAN;
     };
