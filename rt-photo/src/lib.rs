@@ -103,8 +103,8 @@ pub mod units;
 #[cfg(feature = "png")]
 pub use bos::PngError;
 pub use bos::{
-    Background, Bos, BosError, BosImages, BosRig, BosRigOptions, DotBackground, DotGrid,
-    ImageBackground,
+    Background, BackgroundChoice, Bos, BosError, BosImages, BosRig, BosRigOptions, DotBackground,
+    DotGrid, ImageBackground,
 };
 pub use camera::{Airy, AiryKernel, CameraError, Sensor, SensorError, ThinLens};
 pub use focusing::{
@@ -115,9 +115,8 @@ pub use schlieren::{
     Photon, Reconstruction, SchlierenBench, Weighting,
 };
 pub use setup::{
-    Axis, BackgroundChoice, BosOptions, BosSetup, CutoffKind, FocusingOptions, FocusingSetup,
-    MAX_EDGE, MAX_PHOTONS, SchlierenOptions, SchlierenSetup, SetupError, Survey, lattice,
-    traced_per_pixel,
+    Axis, BosOptions, BosSetup, CutoffKind, FocusingOptions, FocusingSetup, MAX_EDGE, MAX_PHOTONS,
+    SchlierenOptions, SchlierenSetup, SetupError, Survey, lattice, traced_per_pixel,
 };
 // The types in this crate's signatures, from the crates below it (and
 // `build_octree`, the way to a grid's `Octree`).

@@ -282,3 +282,25 @@ impl ImageBackground {
         top + ty * (bottom - top)
     }
 }
+
+/// The background behind the flow.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum BackgroundChoice {
+    /// Random dots (seeded by [`crate::BosOptions::seed`]).
+    #[default]
+    Random,
+    /// A regular grid of dots.
+    Grid,
+    /// A grey image, row 0 at the top.
+    Image {
+        /// Pixels across.
+        width: usize,
+        /// Pixels down.
+        height: usize,
+        /// Grey levels, row by row.
+        samples: Vec<f64>,
+        /// Sensor pixels one image pixel covers as imaged (`None`: the
+        /// image spans the sensor's width).
+        pixel: Option<f64>,
+    },
+}

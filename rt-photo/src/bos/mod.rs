@@ -8,7 +8,7 @@ mod png_image;
 mod render;
 mod rig;
 
-pub use background::{Background, DotBackground, DotGrid, ImageBackground};
+pub use background::{Background, BackgroundChoice, DotBackground, DotGrid, ImageBackground};
 #[cfg(feature = "png")]
 pub use png_image::PngError;
 pub use render::{Bos, BosError, BosImages};

@@ -9,7 +9,7 @@ use alloc::{
 use core::fmt;
 use std::{fs::File, io::BufReader, path::Path};
 
-use crate::BackgroundChoice;
+use super::BackgroundChoice;
 
 /// The most pixels [`BackgroundChoice::read_png`] reads (4096 × 4096).
 const MAX_PIXELS: u64 = 1 << 24;

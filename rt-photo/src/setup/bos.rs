@@ -2,37 +2,13 @@
 //! chosen for the flow's deflections, a thin-lens camera and a
 //! background.
 
-use alloc::vec::Vec;
-
 use rt_volume::Medium;
 
 use super::error::{positive, within};
 use crate::{
-    Axis, Background, Bos, BosImages, BosRig, BosRigOptions, Cutoff, DotBackground, DotGrid,
-    ImageBackground, Mode, SetupError, Survey, ThinLens,
+    Axis, Background, BackgroundChoice, Bos, BosImages, BosRig, BosRigOptions, Cutoff,
+    DotBackground, DotGrid, ImageBackground, Mode, SetupError, Survey, ThinLens,
 };
-
-/// The background behind the flow.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub enum BackgroundChoice {
-    /// Random dots (seeded by [`BosOptions::seed`]).
-    #[default]
-    Random,
-    /// A regular grid of dots.
-    Grid,
-    /// A grey image, row 0 at the top.
-    Image {
-        /// Pixels across.
-        width: usize,
-        /// Pixels down.
-        height: usize,
-        /// Grey levels, row by row.
-        samples: Vec<f64>,
-        /// Sensor pixels one image pixel covers as imaged (`None`: the
-        /// image spans the sensor's width).
-        pixel: Option<f64>,
-    },
-}
 
 /// What a BOS recording is to be; `None` means "choose it from the
 /// medium" (by [`BosRig::choose`]).

@@ -14,7 +14,7 @@ mod schlieren;
 mod survey;
 mod view;
 
-pub use bos::{BackgroundChoice, BosOptions, BosSetup};
+pub use bos::{BosOptions, BosSetup};
 pub use error::SetupError;
 pub use focusing::{FocusingOptions, FocusingSetup};
 pub use schlieren::{
