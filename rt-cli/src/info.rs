@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use rt_photo::{
-    Cell, Cutoff, Medium, MeshTrace, Mode, SchlierenBench, Survey,
+    Cell, Medium, MeshTrace, Survey,
     units::{index, si, sig3},
 };
 use rt_surface::io::{MeshData, read_mesh};
@@ -190,14 +190,7 @@ fn unstructured(a: &Args) -> anyhow::Result<String> {
 
 /// The survey's line of `rt info`.
 fn survey_line(a: &Args, medium: &Medium) -> anyhow::Result<String> {
-    let probe = SchlierenBench::through(
-        medium.bounds(),
-        a.axis.into(),
-        Mode::Schlieren(Cutoff::None),
-        0.0,
-        medium.params(),
-    );
-    let survey = Survey::of(medium, &probe, Survey::WIDTH)?;
+    let survey = Survey::through(medium, a.axis.into(), Survey::WIDTH)?;
     let rad = |x: f64| if x == 0.0 { "0 rad".to_string() } else { si(x, "rad") };
     Ok(format!(
         "deflection along {} (one photon per pixel of a {}-wide survey): |ε| median {}, 99th percentile {}, max {}\n",

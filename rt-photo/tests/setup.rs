@@ -41,14 +41,7 @@ fn the_survey_measures_weak_flows() {
     let m =
         Medium::from_grid(bump(48, 1.5e-3, sigma, amp), Samples::AIR, false, Interp::CatmullRom)
             .unwrap();
-    let probe = SchlierenBench::through(
-        m.bounds(),
-        Axis::Z,
-        Mode::Schlieren(Cutoff::None),
-        0.0,
-        m.params(),
-    );
-    let survey = Survey::of(&m, &probe, Survey::WIDTH).unwrap();
+    let survey = Survey::through(&m, Axis::Z, Survey::WIDTH).unwrap();
     let exact = GLADSTONE_DALE_AIR * amp * core::f64::consts::TAU.sqrt() * (-0.5f64).exp();
     let got = survey.magnitude(1.0);
     assert!((got / exact - 1.0).abs() < 0.1, "survey max |ε| {got:e}, analytic {exact:e}");
@@ -86,14 +79,7 @@ fn each_cutoff_chooses_from_the_data() {
     assert!(shadow.bench.film_distance > 0.0 && shadow.title() == "Shadowgraph");
     let colour = choose(CutoffKind::Color);
     let Mode::Schlieren(Cutoff::Color(filter)) = &colour.bench.mode else { panic!("colour") };
-    let probe = SchlierenBench::through(
-        m.bounds(),
-        Axis::Z,
-        Mode::Schlieren(Cutoff::None),
-        0.0,
-        m.params(),
-    );
-    let largest = Survey::of(&m, &probe, 48).unwrap().magnitude(1.0);
+    let largest = Survey::through(&m, Axis::Z, 48).unwrap().magnitude(1.0);
     assert!(filter.half_range > 0.5 * largest && filter.half_range <= largest);
     let Mode::Interferometry { n_ref, .. } = choose(CutoffKind::Interferometry).bench.mode else {
         panic!("interferometry")

@@ -6,8 +6,8 @@ use rt_volume::Medium;
 
 use super::error::{positive, within};
 use crate::{
-    Axis, Background, BackgroundChoice, Bos, BosImages, BosRig, BosRigOptions, Cutoff,
-    DotBackground, DotGrid, ImageBackground, Mode, SetupError, Survey, ThinLens,
+    Axis, Background, BackgroundChoice, Bos, BosImages, BosRig, BosRigOptions, DotBackground,
+    DotGrid, ImageBackground, SetupError, Survey, ThinLens,
 };
 
 /// What a BOS recording is to be; `None` means "choose it from the
@@ -91,14 +91,7 @@ impl BosSetup {
         let ext = b.max - b.min;
         let (w, h) = o.axis.image_size(b, o.size as usize);
         let deflection = if o.rig.background_distance.is_none() {
-            let probe = crate::SchlierenBench::through(
-                b,
-                o.axis,
-                Mode::Schlieren(Cutoff::None),
-                0.0,
-                medium.params(),
-            );
-            Survey::of(medium, &probe, Survey::WIDTH)?.magnitude(0.99)
+            Survey::through(medium, o.axis, Survey::WIDTH)?.magnitude(0.99)
         } else {
             0.0
         };

@@ -5,8 +5,8 @@ use rt_volume::Medium;
 
 use super::error::{finite, invalid, positive, within};
 use crate::{
-    Axis, Cutoff, FocusingImages, FocusingRig, FocusingRigOptions, FocusingSchlieren, Mode,
-    SetupError, SourceGrid, Survey, ThinLens,
+    Axis, FocusingImages, FocusingRig, FocusingRigOptions, FocusingSchlieren, SetupError,
+    SourceGrid, Survey, ThinLens,
 };
 
 /// What a focusing-schlieren image is to be; `None` means "choose it from
@@ -100,14 +100,7 @@ impl FocusingSetup {
         let (w, h) = o.axis.image_size(b, o.size as usize);
         let angle = o.angle.to_radians();
         let deflection = if o.rig.grid_pitch.is_none() {
-            let probe = crate::SchlierenBench::through(
-                b,
-                o.axis,
-                Mode::Schlieren(Cutoff::None),
-                0.0,
-                medium.params(),
-            );
-            Survey::of(medium, &probe, Survey::WIDTH)?.along(angle, 0.99)
+            Survey::through(medium, o.axis, Survey::WIDTH)?.along(angle, 0.99)
         } else {
             0.0
         };

@@ -5,7 +5,7 @@ use alloc::vec::Vec;
 
 use rt_volume::Medium;
 
-use crate::{Cutoff, Film, Filter, Mode, SchlierenBench, SetupError, math};
+use crate::{Axis, Cutoff, Film, Filter, Mode, SchlierenBench, SetupError, math};
 
 /// Mean deflection per pixel of a coarse, uncut image of a medium.
 #[derive(Clone, Debug)]
@@ -46,6 +46,18 @@ impl Survey {
             width,
             pixel: (bench.width / width as f64, bench.height / height),
         })
+    }
+
+    /// The deflections seen looking through the whole of `medium` along
+    /// `axis` (the bench of [`SchlierenBench::through`]), on a film `width`
+    /// pixels wide.
+    ///
+    /// # Errors
+    /// A failing trace.
+    pub fn through(medium: &Medium, axis: Axis, width: usize) -> Result<Self, SetupError> {
+        let none = Mode::Schlieren(Cutoff::None);
+        let probe = SchlierenBench::through(medium.bounds(), axis, none, 0.0, medium.params());
+        Self::of(medium, &probe, width)
     }
 
     /// The `q`-quantile of `|ε|`.
