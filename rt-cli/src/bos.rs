@@ -41,7 +41,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Axis::Z)]
     pub axis: Axis,
     /// Image width in pixels (height follows the volume's aspect).
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=i64::from(rt_photo::MAX_CAMERA_EDGE)))]
     pub size: u32,
     /// Lens focal length in metres [default: of the usual lenses (24 mm to
     /// 400 mm), the one that fills the image with the volume about 1.5 m
@@ -81,7 +81,7 @@ pub struct Args {
     #[arg(long, default_value_t = 4.0, value_parser = parse::positive, allow_hyphen_values = true)]
     pub spacing: f64,
     /// k: k × k stratified aperture samples per pixel.
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=64))]
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=i64::from(rt_photo::MAX_APERTURE_SAMPLES)))]
     pub samples_per_axis: u32,
     /// Sensor: electrons at the brightest dot's centre (about 1 in the
     /// background's units).

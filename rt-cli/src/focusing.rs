@@ -38,7 +38,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Axis::Z)]
     pub axis: Axis,
     /// Image width in pixels (height follows the volume's aspect).
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=i64::from(rt_photo::MAX_CAMERA_EDGE)))]
     pub size: u32,
     /// Schlieren lens focal length in metres [default: a quarter of
     /// --distance, so f/2 at the default aperture].
@@ -91,7 +91,7 @@ pub struct Args {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub bands: Option<u32>,
     /// k: k² aperture samples per pixel (stripes along the bands).
-    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=64))]
+    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=i64::from(rt_photo::MAX_APERTURE_SAMPLES)))]
     pub samples_per_axis: u32,
     /// Sensor: electrons at the undisturbed background.
     #[arg(long, default_value_t = 5000.0, value_parser = parse::finite, allow_hyphen_values = true)]

@@ -106,7 +106,7 @@ pub struct Args {
     /// light onto the film where its corners land, by exact area, so an
     /// undisturbed beam has no grain at all and more photons sharpen the
     /// image rather than average noise. Rounded up to whole passes.
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=i64::from(rt_photo::MAX_PHOTONS_PER_PIXEL)))]
     pub photons: u32,
     /// How photons become the image: `sheet` (each pass's lattice of
     /// photons carried onto the film by exact area: no grain) or `photons`

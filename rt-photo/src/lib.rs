@@ -115,8 +115,9 @@ pub use schlieren::{
     Photon, Reconstruction, SchlierenBench, Weighting,
 };
 pub use setup::{
-    Axis, BosOptions, BosSetup, CutoffKind, FocusingOptions, FocusingSetup, MAX_EDGE, MAX_PHOTONS,
-    SchlierenOptions, SchlierenSetup, SetupError, Survey, lattice, traced_per_pixel,
+    Axis, BosOptions, BosSetup, CutoffKind, FocusingOptions, FocusingSetup, MAX_APERTURE_SAMPLES,
+    MAX_CAMERA_EDGE, MAX_EDGE, MAX_PHOTONS, MAX_PHOTONS_PER_PIXEL, SchlierenOptions,
+    SchlierenSetup, SetupError, Survey, lattice, traced_per_pixel,
 };
 // The types in this crate's signatures, from the crates below it (and
 // `build_octree`, the way to a grid's `Octree`).

@@ -68,8 +68,8 @@ impl BosSetup {
     /// An option out of range, a camera inside its focal length of the
     /// volume, a bad background, a failing survey.
     pub fn choose(medium: &Medium, o: &BosOptions) -> Result<Self, SetupError> {
-        within("size", o.size, 1, 8192)?;
-        within("samples", o.samples_per_axis, 1, 64)?;
+        within("size", o.size, 1, super::MAX_CAMERA_EDGE)?;
+        within("samples", o.samples_per_axis, 1, super::MAX_APERTURE_SAMPLES)?;
         positive("f_number", o.f_number)?;
         positive("dot", o.dot)?;
         positive("spacing", o.spacing)?;

@@ -69,8 +69,8 @@ impl FocusingSetup {
     /// # Errors
     /// An option out of range, a bad rig, a failing survey.
     pub fn choose(medium: &Medium, o: &FocusingOptions) -> Result<Self, SetupError> {
-        within("size", o.size, 1, 8192)?;
-        within("samples", o.samples_per_axis, 1, 64)?;
+        within("size", o.size, 1, super::MAX_CAMERA_EDGE)?;
+        within("samples", o.samples_per_axis, 1, super::MAX_APERTURE_SAMPLES)?;
         finite("focus", o.focus)?;
         finite("angle", o.angle)?;
         if !(o.duty > 0.0 && o.duty < 1.0) {

@@ -15,10 +15,17 @@ mod survey;
 mod view;
 
 pub use bos::{BosOptions, BosSetup};
+
+/// The widest camera image (BOS, focusing schlieren) a set-up accepts,
+/// in pixels.
+pub const MAX_CAMERA_EDGE: u32 = 8192;
+/// The most aperture samples per axis of a camera set-up.
+pub const MAX_APERTURE_SAMPLES: u32 = 64;
 pub use error::SetupError;
 pub use focusing::{FocusingOptions, FocusingSetup};
 pub use schlieren::{
-    CutoffKind, MAX_EDGE, MAX_PHOTONS, SchlierenOptions, SchlierenSetup, lattice, traced_per_pixel,
+    CutoffKind, MAX_EDGE, MAX_PHOTONS, MAX_PHOTONS_PER_PIXEL, SchlierenOptions, SchlierenSetup,
+    lattice, traced_per_pixel,
 };
 pub use survey::Survey;
 pub use view::Axis;

@@ -17,6 +17,8 @@ use crate::{
 pub const MAX_EDGE: u32 = 16384;
 /// The most photons one render traces.
 pub const MAX_PHOTONS: u64 = 1 << 36;
+/// The most photons per pixel a set-up accepts.
+pub const MAX_PHOTONS_PER_PIXEL: u32 = 65536;
 
 /// The optical set-up of a [`SchlierenOptions`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -112,7 +114,7 @@ impl SchlierenOptions {
         self.fringes.map(|v| positive("fringe_spacing", v)).transpose()?;
         self.film_distance.map(|v| finite("film_distance", v)).transpose()?;
         within("size", self.size, 1, MAX_EDGE)?;
-        within("photons", self.photons, 1, 65536)?;
+        within("photons", self.photons, 1, MAX_PHOTONS_PER_PIXEL)?;
         Ok(())
     }
 }
