@@ -1,6 +1,11 @@
 //! The real GL behind the interposer: functions looked up with
 //! `dlsym(RTLD_NEXT, name)`, i.e. in the libraries loaded after this one
-//! (the system's libGL).
+//! (the system's libGL), and where the program never linked libGL but
+//! opened it privately (`dlopen` with `RTLD_LOCAL`, as Qt's GLX plugin
+//! does) in that library itself, opened by name. A function found in
+//! neither is missing: its calls do nothing, it is named once on stderr,
+//! and `glXGetProcAddress` answers null for it, as GL does for an unknown
+//! name; never a null pointer called.
 
 use core::ffi::{CStr, c_void};
 use std::sync::OnceLock;
@@ -19,19 +24,65 @@ impl RealFn {
     /// The function's address, or `None` if no later library has it.
     pub(crate) fn get(&self) -> Option<*const c_void> {
         let p = *self.ptr.get_or_init(|| {
-            // SAFETY: `name` is a NUL-terminated string; RTLD_NEXT asks the
-            // dynamic linker for the next definition after this library.
-            let p = unsafe { libc::dlsym(libc::RTLD_NEXT, self.name.as_ptr()) } as usize;
-            if p != 0 || self.name.to_bytes().starts_with(b"glX") {
-                return p;
+            let p = lookup(self.name);
+            if p == 0 {
+                eprintln!(
+                    "rt-gl: {} is not in the system's GL; its calls are dropped",
+                    self.name.to_string_lossy()
+                );
             }
-            // Extensions and newer entry points a libGL may not export:
-            // ask GLX, as programs do.
-            // SAFETY: a NUL-terminated name.
-            unsafe { glXGetProcAddressARB(self.name.as_ptr().cast()) }.map_or(0, |f| f as usize)
+            p
         });
         (p != 0).then_some(p as *const c_void)
     }
+}
+
+/// The real GL's `name`: the next definition after this library, else
+/// libGL's own (opened privately by the program), else, for names that
+/// are not GLX's, what GLX answers (extensions a libGL may not export).
+fn lookup(name: &CStr) -> usize {
+    // SAFETY: `name` is a NUL-terminated string; RTLD_NEXT asks the
+    // dynamic linker for the next definition after this library.
+    let p = unsafe { libc::dlsym(libc::RTLD_NEXT, name.as_ptr()) } as usize;
+    if p != 0 {
+        return p;
+    }
+    if let Some(gl) = system_gl() {
+        // SAFETY: a handle from dlopen and a NUL-terminated name; the
+        // lookup is in libGL and its dependencies, not in this library.
+        let p = unsafe { libc::dlsym(gl as *mut c_void, name.as_ptr()) } as usize;
+        if p != 0 {
+            return p;
+        }
+    }
+    if name.to_bytes().starts_with(b"glX") {
+        return 0;
+    }
+    // SAFETY: a NUL-terminated name.
+    unsafe { glXGetProcAddressARB(name.as_ptr().cast()) }.map_or(0, |f| f as usize)
+}
+
+/// The system's libGL, as a handle of its own: the one the program
+/// loaded (privately or not), else opened here; `None` if there is none.
+fn system_gl() -> Option<usize> {
+    static GL: OnceLock<usize> = OnceLock::new();
+    let h = *GL.get_or_init(|| {
+        for name in [c"libGL.so.1", c"libGL.so"] {
+            for flags in [
+                libc::RTLD_LAZY | libc::RTLD_LOCAL | libc::RTLD_NOLOAD,
+                libc::RTLD_LAZY | libc::RTLD_LOCAL,
+            ] {
+                // SAFETY: a NUL-terminated library name; RTLD_LOCAL keeps
+                // its symbols out of the global scope.
+                let h = unsafe { libc::dlopen(name.as_ptr(), flags) } as usize;
+                if h != 0 {
+                    return h;
+                }
+            }
+        }
+        0
+    });
+    (h != 0).then_some(h)
 }
 
 /// Declares `pub(crate) unsafe fn name(args) -> ret` calling the real

@@ -1,0 +1,145 @@
+/*
+ * A program that loads its GL the way toolkits do (Qt's GLX plugin,
+ * Python bindings): libGL is opened with dlopen(RTLD_LOCAL), never
+ * linked, and every entry point comes from glXGetProcAddressARB, itself
+ * found through the global scope (RTLD_DEFAULT) first, as a toolkit that
+ * also supports an already-loaded GL does. Under an interposer that finds
+ * the real GL only in the global scope, the entry points come back null.
+ * It knows nothing of rt-gl.
+ *
+ *   private_gl frames   draw a lit, rotating sphere-ish fan of triangles
+ *                       for `frames` frames; prints "frames <n>"
+ *
+ * Build: cc -O2 -o private_gl private_gl.c -lX11 -ldl -lm
+ */
+#include <GL/gl.h>
+#include <GL/glx.h>
+#include <X11/Xlib.h>
+#include <dlfcn.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+typedef void (*fn)(void);
+typedef fn (*getproc_t)(const GLubyte *);
+static getproc_t getproc;
+
+/* `name` from GL, or exit 2 with its name: a null entry point is the
+ * crash this program exists to catch, told apart from others. */
+static fn need(const char *name) {
+    fn f = getproc((const GLubyte *)name);
+    if (!f) {
+        fprintf(stderr, "private_gl: %s is null\n", name);
+        exit(2);
+    }
+    return f;
+}
+
+int main(int argc, char **argv) {
+    int frames = argc >= 2 ? atoi(argv[1]) : 4;
+    void *gl = dlopen("libGL.so.1", RTLD_NOW | RTLD_LOCAL);
+    if (!gl) {
+        fprintf(stderr, "private_gl: %s\n", dlerror());
+        return 1;
+    }
+    getproc = (getproc_t)dlsym(RTLD_DEFAULT, "glXGetProcAddressARB");
+    if (!getproc) getproc = (getproc_t)dlsym(gl, "glXGetProcAddressARB");
+    if (!getproc) {
+        fprintf(stderr, "private_gl: no glXGetProcAddressARB\n");
+        return 1;
+    }
+    XVisualInfo *(*chooseVisual)(Display *, int, int *) = (void *)need("glXChooseVisual");
+    GLXContext (*createContext)(Display *, XVisualInfo *, GLXContext, Bool) =
+        (void *)need("glXCreateContext");
+    Bool (*makeCurrent)(Display *, GLXDrawable, GLXContext) = (void *)need("glXMakeCurrent");
+    void (*swapBuffers)(Display *, GLXDrawable) = (void *)need("glXSwapBuffers");
+    void (*destroyContext)(Display *, GLXContext) = (void *)need("glXDestroyContext");
+
+    Display *dpy = XOpenDisplay(NULL);
+    if (!dpy) {
+        fprintf(stderr, "private_gl: cannot open the X display\n");
+        return 1;
+    }
+    int attrs[] = {GLX_RGBA, GLX_DOUBLEBUFFER, GLX_DEPTH_SIZE, 16, GLX_RED_SIZE, 8, None};
+    XVisualInfo *vi = chooseVisual(dpy, DefaultScreen(dpy), attrs);
+    if (!vi) {
+        fprintf(stderr, "private_gl: no double-buffered RGBA visual\n");
+        return 1;
+    }
+    XSetWindowAttributes swa;
+    swa.colormap = XCreateColormap(dpy, RootWindow(dpy, vi->screen), vi->visual, AllocNone);
+    swa.event_mask = ExposureMask;
+    Window win = XCreateWindow(dpy, RootWindow(dpy, vi->screen), 0, 0, 256, 256, 0, vi->depth,
+                               InputOutput, vi->visual, CWColormap | CWEventMask, &swa);
+    GLXContext ctx = createContext(dpy, vi, NULL, True);
+    XMapWindow(dpy, win);
+    makeCurrent(dpy, win, ctx);
+
+    void (*viewport)(GLint, GLint, GLsizei, GLsizei) = (void *)need("glViewport");
+    void (*clearColor)(GLfloat, GLfloat, GLfloat, GLfloat) = (void *)need("glClearColor");
+    void (*clear)(GLbitfield) = (void *)need("glClear");
+    void (*enable)(GLenum) = (void *)need("glEnable");
+    void (*matrixMode)(GLenum) = (void *)need("glMatrixMode");
+    void (*loadIdentity)(void) = (void *)need("glLoadIdentity");
+    void (*frustum)(GLdouble, GLdouble, GLdouble, GLdouble, GLdouble, GLdouble) =
+        (void *)need("glFrustum");
+    void (*translatef)(GLfloat, GLfloat, GLfloat) = (void *)need("glTranslatef");
+    void (*rotatef)(GLfloat, GLfloat, GLfloat, GLfloat) = (void *)need("glRotatef");
+    void (*lightfv)(GLenum, GLenum, const GLfloat *) = (void *)need("glLightfv");
+    void (*begin)(GLenum) = (void *)need("glBegin");
+    void (*end)(void) = (void *)need("glEnd");
+    void (*color3f)(GLfloat, GLfloat, GLfloat) = (void *)need("glColor3f");
+    void (*normal3f)(GLfloat, GLfloat, GLfloat) = (void *)need("glNormal3f");
+    void (*vertex3f)(GLfloat, GLfloat, GLfloat) = (void *)need("glVertex3f");
+    void (*finish)(void) = (void *)need("glFinish");
+
+    viewport(0, 0, 256, 256);
+    clearColor(0.1f, 0.1f, 0.15f, 1.0f);
+    enable(GL_DEPTH_TEST);
+    enable(GL_LIGHTING);
+    enable(GL_LIGHT0);
+    enable(GL_COLOR_MATERIAL);
+    GLfloat pos[4] = {1.0f, 2.0f, 3.0f, 0.0f};
+    for (int f = 0; f < frames; f++) {
+        clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        matrixMode(GL_PROJECTION);
+        loadIdentity();
+        frustum(-0.6, 0.6, -0.6, 0.6, 1.0, 20.0);
+        matrixMode(GL_MODELVIEW);
+        loadIdentity();
+        lightfv(GL_LIGHT0, GL_POSITION, pos);
+        translatef(0.0f, 0.0f, -4.0f);
+        rotatef(20.0f * f, 0.3f, 1.0f, 0.0f);
+        /* A faceted ball: latitude bands of quads as triangle pairs. */
+        color3f(0.9f, 0.5f, 0.2f);
+        begin(GL_TRIANGLES);
+        const int n = 16;
+        for (int i = 0; i < n; i++) {
+            for (int j = 0; j < 2 * n; j++) {
+                double t0 = M_PI * i / n, t1 = M_PI * (i + 1) / n;
+                double p0 = M_PI * j / n, p1 = M_PI * (j + 1) / n;
+                double v[4][3] = {
+                    {sin(t0) * cos(p0), cos(t0), sin(t0) * sin(p0)},
+                    {sin(t1) * cos(p0), cos(t1), sin(t1) * sin(p0)},
+                    {sin(t1) * cos(p1), cos(t1), sin(t1) * sin(p1)},
+                    {sin(t0) * cos(p1), cos(t0), sin(t0) * sin(p1)},
+                };
+                int tri[6] = {0, 1, 2, 0, 2, 3};
+                for (int k = 0; k < 6; k++) {
+                    double *p = v[tri[k]];
+                    normal3f(p[0], p[1], p[2]);
+                    vertex3f(1.2 * p[0], 1.2 * p[1], 1.2 * p[2]);
+                }
+            }
+        }
+        end();
+        swapBuffers(dpy, win);
+        finish();
+    }
+    printf("frames %d\n", frames);
+    makeCurrent(dpy, None, NULL);
+    destroyContext(dpy, ctx);
+    XDestroyWindow(dpy, win);
+    XCloseDisplay(dpy);
+    return 0;
+}
