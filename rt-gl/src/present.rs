@@ -44,6 +44,9 @@ fn present_frame(buffer: u32) {
         return;
     };
     let n = FRAME.fetch_add(1, Ordering::Relaxed);
+    // A program that never calls glViewport draws in GL's initial one,
+    // the drawable's size when the context was first made current.
+    let viewport = if viewport[2] > 0 && viewport[3] > 0 { viewport } else { real_viewport() };
     let [x, y, w, h] = viewport;
     if w <= 0 || h <= 0 {
         return;
@@ -106,6 +109,14 @@ fn present_frame(buffer: u32) {
     if cfg.stats {
         eprintln!("rt-gl: frame {n}: {:?}", counters);
     }
+}
+
+/// The real GL's current viewport.
+fn real_viewport() -> [i32; 4] {
+    let mut v = [0i32; 4];
+    // SAFETY: GL_VIEWPORT is four integers.
+    unsafe { real::glGetIntegerv(0x0BA2, v.as_mut_ptr()) };
+    v
 }
 
 /// What the real GL rasterized into `buffer` in the viewport.

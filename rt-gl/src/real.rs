@@ -128,6 +128,7 @@ real_fns! {
     glReadPixels(x: i32, y: i32, w: i32, h: i32, format: u32, ty: u32, data: *mut c_void);
     glReadBuffer(mode: u32);
     glGetBooleanv(pname: u32, data: *mut u8);
+    glGetIntegerv(pname: u32, data: *mut i32);
     glXSwapBuffers(dpy: *mut c_void, drawable: u64);
     glXGetProcAddress(name: *const u8) -> Option<unsafe extern "C" fn()>;
     glXGetProcAddressARB(name: *const u8) -> Option<unsafe extern "C" fn()>;

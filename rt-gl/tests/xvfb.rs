@@ -287,13 +287,29 @@ fn glxgears_is_traced_with_its_lists_built_once() {
 #[test]
 #[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
 fn a_privately_loaded_gl_is_found_and_traced() {
-    let dir = scratch("private");
+    private_gl_frames_match_the_raster("private", &[]);
+}
+
+/// A program that never calls `glViewport` draws in GL's initial
+/// viewport, the window's size: rt-gl used to see no viewport and trace
+/// no frame, silently; now every frame is traced and agrees with Mesa.
+#[test]
+#[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
+fn a_program_without_glviewport_is_traced() {
+    private_gl_frames_match_the_raster("noviewport", &["noviewport"]);
+}
+
+/// Runs the private-GL program with `args` after the frame count; every
+/// frame traced, each agreeing with Mesa's raster.
+fn private_gl_frames_match_the_raster(name: &str, args: &[&str]) {
+    let dir = scratch(name);
     let exe = private_gl_program(&dir);
     let frames = 6;
     let out = Command::new(tool("xvfb-run"))
         .args(["-a", "-s", "-screen 0 640x480x24"])
         .arg(&exe)
         .arg(frames.to_string())
+        .args(args)
         .env("LD_PRELOAD", interposer())
         .env("RT_GL_DUMP", &dir)
         .env("RT_GL_DUMP_RASTER", "1")

@@ -7,8 +7,11 @@
  * the real GL only in the global scope, the entry points come back null.
  * It knows nothing of rt-gl.
  *
- *   private_gl frames   draw a lit, rotating sphere-ish fan of triangles
- *                       for `frames` frames; prints "frames <n>"
+ *   private_gl frames [noviewport]
+ *                       draw a lit, rotating ball of triangles for
+ *                       `frames` frames; prints "frames <n>". With
+ *                       `noviewport`, never call glViewport: GL's initial
+ *                       viewport (the window's size) is the one in force.
  *
  * Build: cc -O2 -o private_gl private_gl.c -lX11 -ldl -lm
  */
@@ -19,6 +22,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 typedef void (*fn)(void);
 typedef fn (*getproc_t)(const GLubyte *);
@@ -37,6 +41,7 @@ static fn need(const char *name) {
 
 int main(int argc, char **argv) {
     int frames = argc >= 2 ? atoi(argv[1]) : 4;
+    int set_viewport = !(argc >= 3 && strcmp(argv[2], "noviewport") == 0);
     void *gl = dlopen("libGL.so.1", RTLD_NOW | RTLD_LOCAL);
     if (!gl) {
         fprintf(stderr, "private_gl: %s\n", dlerror());
@@ -93,7 +98,7 @@ int main(int argc, char **argv) {
     void (*vertex3f)(GLfloat, GLfloat, GLfloat) = (void *)need("glVertex3f");
     void (*finish)(void) = (void *)need("glFinish");
 
-    viewport(0, 0, 256, 256);
+    if (set_viewport) viewport(0, 0, 256, 256);
     clearColor(0.1f, 0.1f, 0.15f, 1.0f);
     enable(GL_DEPTH_TEST);
     enable(GL_LIGHTING);
