@@ -145,6 +145,11 @@ fn rec(c: Command) {
     with_recorder(|r| r.command(c));
 }
 
+/// Notes a call the trace does not honour (reported at the next frame).
+fn unsupported(what: &'static str) {
+    with_recorder(|r| r.unsupported(what));
+}
+
 intercept! {
     glBegin(mode: u32) { rec(Command::Begin(mode)) }
     glEnd() { rec(Command::End) }
@@ -212,6 +217,16 @@ intercept! {
     glClearColor(r: f32, g: f32, b: f32, a: f32) { with_recorder(|rec| rec.clear_color = Vec4::new(r, g, b, a).clamp(Vec4::ZERO, Vec4::ONE)) }
     glClear(mask: u32) { with_recorder(|r| r.clear(mask)) }
     glEnable(cap: u32) { rec(Command::Enable(cap)) }
+    glPolygonMode(face: u32, mode: u32) { let _ = face; if mode != 0x1B02 { unsupported("glPolygonMode(GL_LINE|GL_POINT)") } }
+    glFrontFace(mode: u32) { if mode == 0x0900 { unsupported("glFrontFace(GL_CW)") } }
+    glRectf(x1: f32, y1: f32, x2: f32, y2: f32) { let _ = (x1, y1, x2, y2); unsupported("glRect") }
+    glRectd(x1: f64, y1: f64, x2: f64, y2: f64) { let _ = (x1, y1, x2, y2); unsupported("glRect") }
+    glRecti(x1: i32, y1: i32, x2: i32, y2: i32) { let _ = (x1, y1, x2, y2); unsupported("glRect") }
+    glRects(x1: i16, y1: i16, x2: i16, y2: i16) { let _ = (x1, y1, x2, y2); unsupported("glRect") }
+    glInterleavedArrays(format: u32, stride: i32, p: *const c_void) { let _ = (format, stride, p); unsupported("glInterleavedArrays") }
+    glBitmap(w: i32, h: i32, xo: f32, yo: f32, xm: f32, ym: f32, b: *const u8) { let _ = (w, h, xo, yo, xm, ym, b); unsupported("glBitmap") }
+    glDrawPixels(w: i32, h: i32, format: u32, ty: u32, data: *const c_void) { let _ = (w, h, format, ty, data); unsupported("glDrawPixels") }
+    glUseProgram(program: u32) { if program != 0 { unsupported("glUseProgram") } }
     glDisable(cap: u32) { rec(Command::Disable(cap)) }
     glShadeModel(mode: u32) { rec(Command::ShadeModel(mode)) }
     glPointSize(size: f32) { rec(Command::PointSize(size)) }

@@ -37,12 +37,24 @@ fn present_frame(buffer: u32) {
         }
         let frame = r.end_frame();
         let counters = r.counters;
-        Some((frame, r.lighting.clone(), r.projection(), r.viewport, r.clear_color, counters))
+        let unsupported: Vec<(&'static str, u64)> =
+            r.unsupported.iter().map(|(k, v)| (*k, *v)).collect();
+        let state = (r.lighting.clone(), r.projection(), r.viewport, r.clear_color);
+        Some((frame, state, counters, unsupported))
     })
     .flatten();
-    let Some((frame, lighting, projection, viewport, background, counters)) = taken else {
+    let Some((frame, (lighting, projection, viewport, background), counters, unsupported)) = taken
+    else {
         return;
     };
+    for (what, _) in &unsupported {
+        log_once(
+            &format!("unsupported {what}"),
+            &format!(
+                "{what} is not traced: the frame shows the geometry without it (counts in counters.txt with RT_GL_DUMP)"
+            ),
+        );
+    }
     let n = FRAME.fetch_add(1, Ordering::Relaxed);
     // A program that never calls glViewport draws in GL's initial one,
     // the drawable's size when the context was first made current.
@@ -57,32 +69,10 @@ fn present_frame(buffer: u32) {
             log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
         }
     }
-    if let Some(dir) = &cfg.dump {
-        let c = counters;
-        let line = format!(
-            "frames={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_refits={} draw_inline={} instances={} triangles={} ignored={}\n",
-            c.frames,
-            c.list_builds,
-            c.list_reuses,
-            c.list_inline,
-            c.draw_builds,
-            c.draw_reuses,
-            c.draw_refits,
-            c.draw_inline,
-            c.instances,
-            c.triangles,
-            c.ignored
-        );
-        // Written beside, then renamed over: a program stopped mid-write
-        // (glxgears is stopped by a signal) leaves the previous frame's
-        // counters, never an empty file.
-        let tmp = dir.join("counters.txt.tmp");
-        if std::fs::write(&tmp, line).is_ok() {
-            let _ = std::fs::rename(&tmp, dir.join("counters.txt"));
-        }
-    }
+    let mut left_out = 0;
     let rendered = crate::catch(|| {
         let scene = FrameScene::build(frame)?;
+        left_out = scene.left_out();
         let render =
             || scene.render(&lighting, projection, w as u32, h as u32, background, &cfg.options);
         match &cfg.pool {
@@ -90,6 +80,17 @@ fn present_frame(buffer: u32) {
             None => render(),
         }
     });
+    if left_out > 0 {
+        log_once(
+            "left out",
+            &format!(
+                "instances whose transform cannot place them (singular or projective, as planar shadows') are left out of the trace ({left_out} in frame {n}; left_out in counters.txt)"
+            ),
+        );
+    }
+    if let Some(dir) = &cfg.dump {
+        write_counters(dir, &counters, left_out, &unsupported);
+    }
     let img = match rendered {
         Some(Ok(img)) => img,
         Some(Err(e)) => {
@@ -108,6 +109,42 @@ fn present_frame(buffer: u32) {
     }
     if cfg.stats {
         eprintln!("rt-gl: frame {n}: {:?}", counters);
+    }
+}
+
+/// `counters.txt` in `dir`: the recorder's counters, the instances left
+/// out of the last frame and each unsupported feature's count
+/// (`unsupported.NAME=count`).
+fn write_counters(
+    dir: &std::path::Path,
+    c: &crate::record::Counters,
+    left_out: usize,
+    unsupported: &[(&'static str, u64)],
+) {
+    let mut line = format!(
+        "frames={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_refits={} draw_inline={} instances={} triangles={} ignored={} left_out={left_out}",
+        c.frames,
+        c.list_builds,
+        c.list_reuses,
+        c.list_inline,
+        c.draw_builds,
+        c.draw_reuses,
+        c.draw_refits,
+        c.draw_inline,
+        c.instances,
+        c.triangles,
+        c.ignored
+    );
+    for (what, count) in unsupported {
+        line += &format!(" unsupported.{what}={count}");
+    }
+    line.push('\n');
+    // Written beside, then renamed over: a program stopped mid-write
+    // (glxgears is stopped by a signal) leaves the previous frame's
+    // counters, never an empty file.
+    let tmp = dir.join("counters.txt.tmp");
+    if std::fs::write(&tmp, line).is_ok() {
+        let _ = std::fs::rename(&tmp, dir.join("counters.txt"));
     }
 }
 

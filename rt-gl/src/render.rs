@@ -191,6 +191,7 @@ pub struct FrameScene {
     /// Per instance: the normal matrix of its transform.
     normal: Vec<Mat3>,
     diagonal: f32,
+    left_out: usize,
 }
 
 /// Which geometry a hit belongs to.
@@ -206,13 +207,26 @@ impl FrameScene {
     ///
     /// # Errors
     /// [`RenderError::Geometry`] if a geometry is malformed
-    /// ([`Geometry::check`]) or a primitive is not finite;
-    /// [`RenderError::Instance`] if a transform is singular.
+    /// ([`Geometry::check`]) or a primitive is not finite. An instance
+    /// whose transform cannot place it (singular, projective as a planar
+    /// shadow's, not finite) is left out and counted
+    /// ([`FrameScene::left_out`]), not the frame.
     pub fn build(frame: FrameDraws) -> Result<Self, RenderError> {
         let scene = frame.immediate.build()?;
         let mut objects: Vec<Arc<Recorded>> = Vec::new();
         let mut placements = Vec::with_capacity(frame.instances.len());
+        let placeable = |m: &Mat4| {
+            m.is_finite()
+                && m.determinant() != 0.0
+                && m.inverse().is_finite()
+                && m.row(3) == glam::Vec4::W
+        };
+        let mut left_out = 0;
         for (rec, m) in &frame.instances {
+            if !placeable(m) {
+                left_out += 1;
+                continue;
+            }
             let k = match objects.iter().position(|o| Arc::ptr_eq(o, rec)) {
                 Some(k) => k,
                 None => {
@@ -227,7 +241,14 @@ impl FrameScene {
         let instances = Instances::new(objects, &placements).map_err(RenderError::Instance)?;
         let b = Object::bounds(&scene).union(instances.bounds());
         let diagonal = if b.is_empty() { 0.0 } else { (b.max - b.min).length() };
-        Ok(Self { immediate: frame.immediate, scene, instances, normal, diagonal })
+        Ok(Self { immediate: frame.immediate, scene, instances, normal, diagonal, left_out })
+    }
+
+    /// Instances left out of the trace: their transforms cannot place them
+    /// (singular, projective, not finite).
+    #[must_use]
+    pub fn left_out(&self) -> usize {
+        self.left_out
     }
 
     /// The closest hit among the immediate geometry and the instances.

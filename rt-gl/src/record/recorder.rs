@@ -1,7 +1,10 @@
 //! The recorder's state machine: matrix stacks, current attributes,
 //! lights and materials, and the dispatch of each call.
 
-use std::{collections::HashMap, sync::Arc};
+use std::{
+    collections::{BTreeMap, HashMap},
+    sync::Arc,
+};
 
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
@@ -62,6 +65,9 @@ pub struct Recorder {
     pub(super) draw_shapes: HashMap<DrawKey, DrawKey>,
     /// What has been done so far.
     pub counters: Counters,
+    /// GL features the program used that the trace does not honour, by
+    /// name (`GL_BLEND`, `glRect`, …), with how often they were used.
+    pub unsupported: BTreeMap<&'static str, u64>,
 }
 
 impl Default for Recorder {
@@ -107,6 +113,7 @@ impl Recorder {
             draw_cache: HashMap::new(),
             draw_shapes: HashMap::new(),
             counters: Counters::default(),
+            unsupported: BTreeMap::new(),
         }
     }
 
@@ -280,7 +287,15 @@ impl Recorder {
         }
     }
 
+    /// Notes one use of a GL feature the trace does not honour.
+    pub fn unsupported(&mut self, what: &'static str) {
+        *self.unsupported.entry(what).or_insert(0) += 1;
+    }
+
     fn set_cap(&mut self, cap: u32, on: bool) {
+        if let (true, Some(what)) = (on, unsupported_cap(cap)) {
+            self.unsupported(what);
+        }
         match cap {
             gl::LIGHTING => self.lit = on,
             gl::COLOR_MATERIAL => {
@@ -318,4 +333,23 @@ impl Recorder {
             _ => {}
         }
     }
+}
+
+/// The name of a capability whose effect the trace does not reproduce
+/// (the image shows the geometry as if it were off).
+fn unsupported_cap(cap: u32) -> Option<&'static str> {
+    Some(match cap {
+        0x0DE0 => "GL_TEXTURE_1D",
+        0x0DE1 => "GL_TEXTURE_2D",
+        0x806F => "GL_TEXTURE_3D",
+        0x8513 => "GL_TEXTURE_CUBE_MAP",
+        0x0C60..=0x0C63 => "GL_TEXTURE_GEN",
+        0x0BE2 => "GL_BLEND",
+        0x0B60 => "GL_FOG",
+        0x0BC0 => "GL_ALPHA_TEST",
+        0x0B24 => "GL_LINE_STIPPLE",
+        0x0B42 => "GL_POLYGON_STIPPLE",
+        0x3000..=0x3005 => "GL_CLIP_PLANE",
+        _ => return None,
+    })
 }

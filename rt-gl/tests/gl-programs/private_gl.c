@@ -7,11 +7,14 @@
  * the real GL only in the global scope, the entry points come back null.
  * It knows nothing of rt-gl.
  *
- *   private_gl frames [noviewport]
+ *   private_gl frames [noviewport|shadow]
  *                       draw a lit, rotating ball of triangles for
  *                       `frames` frames; prints "frames <n>". With
  *                       `noviewport`, never call glViewport: GL's initial
  *                       viewport (the window's size) is the one in force.
+ *                       With `shadow`, the ball is a display list, drawn
+ *                       again flattened onto a floor by a projective
+ *                       (planar-shadow) matrix, dark and blended.
  *
  * Build: cc -O2 -o private_gl private_gl.c -lX11 -ldl -lm
  */
@@ -25,6 +28,35 @@
 #include <string.h>
 
 typedef void (*fn)(void);
+/* The entry points ball() draws with (set in main). */
+static void (*p_begin)(GLenum), (*p_end)(void), (*p_color3f)(GLfloat, GLfloat, GLfloat),
+    (*p_normal3f)(GLfloat, GLfloat, GLfloat), (*p_vertex3f)(GLfloat, GLfloat, GLfloat);
+
+/* A faceted ball of radius 1.2: latitude bands of quads as triangle
+ * pairs, in the current colour. */
+static void ball(void) {
+    p_begin(GL_TRIANGLES);
+    const int n = 16;
+    for (int i = 0; i < n; i++) {
+        for (int j = 0; j < 2 * n; j++) {
+            double t0 = M_PI * i / n, t1 = M_PI * (i + 1) / n;
+            double p0 = M_PI * j / n, p1 = M_PI * (j + 1) / n;
+            double v[4][3] = {
+                {sin(t0) * cos(p0), cos(t0), sin(t0) * sin(p0)},
+                {sin(t1) * cos(p0), cos(t1), sin(t1) * sin(p0)},
+                {sin(t1) * cos(p1), cos(t1), sin(t1) * sin(p1)},
+                {sin(t0) * cos(p1), cos(t0), sin(t0) * sin(p1)},
+            };
+            int tri[6] = {0, 1, 2, 0, 2, 3};
+            for (int k = 0; k < 6; k++) {
+                double *p = v[tri[k]];
+                p_normal3f(p[0], p[1], p[2]);
+                p_vertex3f(1.2 * p[0], 1.2 * p[1], 1.2 * p[2]);
+            }
+        }
+    }
+    p_end();
+}
 typedef fn (*getproc_t)(const GLubyte *);
 static getproc_t getproc;
 
@@ -42,6 +74,7 @@ static fn need(const char *name) {
 int main(int argc, char **argv) {
     int frames = argc >= 2 ? atoi(argv[1]) : 4;
     int set_viewport = !(argc >= 3 && strcmp(argv[2], "noviewport") == 0);
+    int shadow = argc >= 3 && strcmp(argv[2], "shadow") == 0;
     void *gl = dlopen("libGL.so.1", RTLD_NOW | RTLD_LOCAL);
     if (!gl) {
         fprintf(stderr, "private_gl: %s\n", dlerror());
@@ -97,8 +130,24 @@ int main(int argc, char **argv) {
     void (*normal3f)(GLfloat, GLfloat, GLfloat) = (void *)need("glNormal3f");
     void (*vertex3f)(GLfloat, GLfloat, GLfloat) = (void *)need("glVertex3f");
     void (*finish)(void) = (void *)need("glFinish");
+    void (*newList)(GLuint, GLenum) = (void *)need("glNewList");
+    void (*endList)(void) = (void *)need("glEndList");
+    void (*callList)(GLuint) = (void *)need("glCallList");
+    void (*pushMatrix)(void) = (void *)need("glPushMatrix");
+    void (*popMatrix)(void) = (void *)need("glPopMatrix");
+    void (*multMatrixf)(const GLfloat *) = (void *)need("glMultMatrixf");
+    void (*disable)(GLenum) = (void *)need("glDisable");
+    void (*blendFunc)(GLenum, GLenum) = (void *)need("glBlendFunc");
+    void (*color4f)(GLfloat, GLfloat, GLfloat, GLfloat) = (void *)need("glColor4f");
 
+    p_begin = begin, p_end = end, p_color3f = color3f, p_normal3f = normal3f,
+    p_vertex3f = vertex3f;
     if (set_viewport) viewport(0, 0, 256, 256);
+    if (shadow) {
+        newList(1, GL_COMPILE);
+        ball();
+        endList();
+    }
     clearColor(0.1f, 0.1f, 0.15f, 1.0f);
     enable(GL_DEPTH_TEST);
     enable(GL_LIGHTING);
@@ -115,29 +164,27 @@ int main(int argc, char **argv) {
         lightfv(GL_LIGHT0, GL_POSITION, pos);
         translatef(0.0f, 0.0f, -4.0f);
         rotatef(20.0f * f, 0.3f, 1.0f, 0.0f);
-        /* A faceted ball: latitude bands of quads as triangle pairs. */
-        color3f(0.9f, 0.5f, 0.2f);
-        begin(GL_TRIANGLES);
-        const int n = 16;
-        for (int i = 0; i < n; i++) {
-            for (int j = 0; j < 2 * n; j++) {
-                double t0 = M_PI * i / n, t1 = M_PI * (i + 1) / n;
-                double p0 = M_PI * j / n, p1 = M_PI * (j + 1) / n;
-                double v[4][3] = {
-                    {sin(t0) * cos(p0), cos(t0), sin(t0) * sin(p0)},
-                    {sin(t1) * cos(p0), cos(t1), sin(t1) * sin(p0)},
-                    {sin(t1) * cos(p1), cos(t1), sin(t1) * sin(p1)},
-                    {sin(t0) * cos(p1), cos(t0), sin(t0) * sin(p1)},
-                };
-                int tri[6] = {0, 1, 2, 0, 2, 3};
-                for (int k = 0; k < 6; k++) {
-                    double *p = v[tri[k]];
-                    normal3f(p[0], p[1], p[2]);
-                    vertex3f(1.2 * p[0], 1.2 * p[1], 1.2 * p[2]);
-                }
-            }
+        p_color3f(0.9f, 0.5f, 0.2f);
+        if (shadow) {
+            callList(1);
+            /* Flattened onto the floor y = -1.5 along the light's
+             * direction (1, 2, 3): a projective matrix (column-major). */
+            const float l[3] = {1.0f, 2.0f, 3.0f}, d = 1.5f;
+            const GLfloat m[16] = {l[1], 0, 0, 0,  -l[0], 0, -l[2], -1,
+                                   0, 0, l[1], 0,  -d * l[0], -d * l[1], -d * l[2], l[1] - d};
+            pushMatrix();
+            multMatrixf(m);
+            disable(GL_LIGHTING);
+            enable(GL_BLEND);
+            blendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+            color4f(0.0f, 0.0f, 0.0f, 0.5f);
+            callList(1);
+            disable(GL_BLEND);
+            enable(GL_LIGHTING);
+            popMatrix();
+        } else {
+            ball();
         }
-        end();
         swapBuffers(dpy, win);
         finish();
     }
