@@ -145,6 +145,21 @@ fn rec(c: Command) {
     with_recorder(|r| r.command(c));
 }
 
+/// `glRect`: GL's own definition, a polygon of the four corners at z = 0
+/// (`glBegin(GL_POLYGON)`, `(x1, y1)`, `(x2, y1)`, `(x2, y2)`, `(x1, y2)`).
+fn rect(x1: f32, y1: f32, x2: f32, y2: f32) {
+    for c in [
+        Command::Begin(gl::POLYGON),
+        v4(x1, y1, 0.0, 1.0),
+        v4(x2, y1, 0.0, 1.0),
+        v4(x2, y2, 0.0, 1.0),
+        v4(x1, y2, 0.0, 1.0),
+        Command::End,
+    ] {
+        rec(c);
+    }
+}
+
 /// Notes a call the trace does not honour (reported at the next frame).
 fn unsupported(what: &'static str) {
     with_recorder(|r| r.unsupported(what));
@@ -219,11 +234,13 @@ intercept! {
     glEnable(cap: u32) { rec(Command::Enable(cap)) }
     glPolygonMode(face: u32, mode: u32) { let _ = face; if mode != 0x1B02 { unsupported("glPolygonMode(GL_LINE|GL_POINT)") } }
     glFrontFace(mode: u32) { if mode == 0x0900 { unsupported("glFrontFace(GL_CW)") } }
-    glRectf(x1: f32, y1: f32, x2: f32, y2: f32) { let _ = (x1, y1, x2, y2); unsupported("glRect") }
-    glRectd(x1: f64, y1: f64, x2: f64, y2: f64) { let _ = (x1, y1, x2, y2); unsupported("glRect") }
-    glRecti(x1: i32, y1: i32, x2: i32, y2: i32) { let _ = (x1, y1, x2, y2); unsupported("glRect") }
-    glRects(x1: i16, y1: i16, x2: i16, y2: i16) { let _ = (x1, y1, x2, y2); unsupported("glRect") }
-    glInterleavedArrays(format: u32, stride: i32, p: *const c_void) { let _ = (format, stride, p); unsupported("glInterleavedArrays") }
+    glRectf(x1: f32, y1: f32, x2: f32, y2: f32) { rect(x1, y1, x2, y2) }
+    glRectd(x1: f64, y1: f64, x2: f64, y2: f64) { rect(x1 as f32, y1 as f32, x2 as f32, y2 as f32) }
+    glRecti(x1: i32, y1: i32, x2: i32, y2: i32) { rect(x1 as f32, y1 as f32, x2 as f32, y2 as f32) }
+    glRects(x1: i16, y1: i16, x2: i16, y2: i16) { rect(x1.into(), y1.into(), x2.into(), y2.into()) }
+    glRectfv(a: *const f32, b: *const f32) { if let (Some([x1, y1]), Some([x2, y2])) = unsafe { (read(a), read(b)) } { rect(x1, y1, x2, y2) } }
+    glRectdv(a: *const f64, b: *const f64) { if let (Some([x1, y1]), Some([x2, y2])) = unsafe { (read(a), read(b)) } { rect(x1 as f32, y1 as f32, x2 as f32, y2 as f32) } }
+    glInterleavedArrays(format: u32, stride: i32, p: *const c_void) { with_recorder(|r| r.interleaved_arrays(format, stride, p as usize)); }
     glBitmap(w: i32, h: i32, xo: f32, yo: f32, xm: f32, ym: f32, b: *const u8) { let _ = (w, h, xo, yo, xm, ym, b); unsupported("glBitmap") }
     glDrawPixels(w: i32, h: i32, format: u32, ty: u32, data: *const c_void) { let _ = (w, h, format, ty, data); unsupported("glDrawPixels") }
     glUseProgram(program: u32) { if program != 0 { unsupported("glUseProgram") } }

@@ -299,6 +299,16 @@ fn a_program_without_glviewport_is_traced() {
     private_gl_frames_match_the_raster("noviewport", &["noviewport"]);
 }
 
+/// A ball from one interleaved array (`glInterleavedArrays`, colour,
+/// normal and vertex in each record, `glDrawArrays`) and a panel drawn
+/// with `glRectf`: both were left out of the trace before (the frame
+/// showed neither); now every frame agrees with Mesa.
+#[test]
+#[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
+fn interleaved_arrays_and_rects_are_traced() {
+    private_gl_frames_match_the_raster("arrays", &["arrays"]);
+}
+
 /// Runs the private-GL program with `args` after the frame count; every
 /// frame traced, each agreeing with Mesa's raster.
 fn private_gl_frames_match_the_raster(name: &str, args: &[&str]) {

@@ -188,6 +188,56 @@ impl Recorder {
         }
     }
 
+    /// `glInterleavedArrays`: the vertex array and, as `format` holds
+    /// them, the colour and normal arrays (on or off) at their offsets in
+    /// one interleaved record; texture coordinates are not traced. An
+    /// unknown format or a negative stride is ignored, as GL ignores it.
+    pub fn interleaved_arrays(&mut self, format: u32, stride: i32, pointer: usize) {
+        const F: i32 = 4;
+        const UB: u32 = 0x1401;
+        const FLOAT: u32 = 0x1406;
+        // (colour: (size, type, offset), normal offset, vertex (size,
+        // offset), record size), in bytes.
+        type Layout = (Option<(i32, u32, i32)>, Option<i32>, (i32, i32), i32);
+        let layout: Layout = match format {
+            0x2A20 => (None, None, (2, 0), 2 * F),
+            0x2A21 => (None, None, (3, 0), 3 * F),
+            0x2A22 => (Some((4, UB, 0)), None, (2, 4), 4 + 2 * F),
+            0x2A23 => (Some((4, UB, 0)), None, (3, 4), 4 + 3 * F),
+            0x2A24 => (Some((3, FLOAT, 0)), None, (3, 3 * F), 6 * F),
+            0x2A25 => (None, Some(0), (3, 3 * F), 6 * F),
+            0x2A26 => (Some((4, FLOAT, 0)), Some(4 * F), (3, 7 * F), 10 * F),
+            0x2A27 => (None, None, (3, 2 * F), 5 * F),
+            0x2A28 => (None, None, (4, 4 * F), 8 * F),
+            0x2A29 => (Some((4, UB, 2 * F)), None, (3, 4 + 2 * F), 4 + 5 * F),
+            0x2A2A => (Some((3, FLOAT, 2 * F)), None, (3, 5 * F), 8 * F),
+            0x2A2B => (None, Some(2 * F), (3, 5 * F), 8 * F),
+            0x2A2C => (Some((4, FLOAT, 2 * F)), Some(6 * F), (3, 9 * F), 12 * F),
+            0x2A2D => (Some((4, FLOAT, 4 * F)), Some(8 * F), (4, 11 * F), 15 * F),
+            _ => {
+                self.counters.ignored += 1;
+                return;
+            }
+        };
+        if stride < 0 {
+            self.counters.ignored += 1;
+            return;
+        }
+        let (color, normal, (vsize, voffset), record) = layout;
+        let stride = if stride == 0 { record } else { stride };
+        let at = |offset: i32| pointer.wrapping_add(offset as usize);
+        self.client_state(COLOR_ARRAY, color.is_some());
+        if let Some((size, ty, offset)) = color {
+            self.pointer(COLOR_ARRAY, size, ty, stride, at(offset));
+        }
+        self.client_state(NORMAL_ARRAY, normal.is_some());
+        if let Some(offset) = normal {
+            self.pointer(NORMAL_ARRAY, 3, FLOAT, stride, at(offset));
+        }
+        self.client_state(VERTEX_ARRAY, true);
+        self.pointer(VERTEX_ARRAY, vsize, FLOAT, stride, at(voffset));
+    }
+
     /// `glBindBuffer(target, buffer)`.
     pub fn bind_buffer(&mut self, target: u32, buffer: u32) {
         match target {

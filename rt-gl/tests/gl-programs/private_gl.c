@@ -15,6 +15,10 @@
  *                       With `shadow`, the ball is a display list, drawn
  *                       again flattened onto a floor by a projective
  *                       (planar-shadow) matrix, dark and blended.
+ *                       With `arrays`, the ball comes from one interleaved
+ *                       array (glInterleavedArrays GL_C4F_N3F_V3F, colour
+ *                       varying with height, glDrawArrays) beside a panel
+ *                       drawn with glRectf.
  *
  * Build: cc -O2 -o private_gl private_gl.c -lX11 -ldl -lm
  */
@@ -75,6 +79,7 @@ int main(int argc, char **argv) {
     int frames = argc >= 2 ? atoi(argv[1]) : 4;
     int set_viewport = !(argc >= 3 && strcmp(argv[2], "noviewport") == 0);
     int shadow = argc >= 3 && strcmp(argv[2], "shadow") == 0;
+    int arrays = argc >= 3 && strcmp(argv[2], "arrays") == 0;
     void *gl = dlopen("libGL.so.1", RTLD_NOW | RTLD_LOCAL);
     if (!gl) {
         fprintf(stderr, "private_gl: %s\n", dlerror());
@@ -139,6 +144,9 @@ int main(int argc, char **argv) {
     void (*disable)(GLenum) = (void *)need("glDisable");
     void (*blendFunc)(GLenum, GLenum) = (void *)need("glBlendFunc");
     void (*color4f)(GLfloat, GLfloat, GLfloat, GLfloat) = (void *)need("glColor4f");
+    void (*interleavedArrays)(GLenum, GLsizei, const void *) = (void *)need("glInterleavedArrays");
+    void (*drawArrays)(GLenum, GLint, GLsizei) = (void *)need("glDrawArrays");
+    void (*rectf)(GLfloat, GLfloat, GLfloat, GLfloat) = (void *)need("glRectf");
 
     p_begin = begin, p_end = end, p_color3f = color3f, p_normal3f = normal3f,
     p_vertex3f = vertex3f;
@@ -147,6 +155,32 @@ int main(int argc, char **argv) {
         newList(1, GL_COMPILE);
         ball();
         endList();
+    }
+    /* The ball as one interleaved array: r, g, b, a, nx, ny, nz, x, y, z. */
+    enum { N = 16, VERTS = N * 2 * N * 6 };
+    static GLfloat record[VERTS][10];
+    if (arrays) {
+        int v = 0;
+        for (int i = 0; i < N; i++) {
+            for (int j = 0; j < 2 * N; j++) {
+                double t0 = M_PI * i / N, t1 = M_PI * (i + 1) / N;
+                double p0 = M_PI * j / N, p1 = M_PI * (j + 1) / N;
+                double q[4][3] = {
+                    {sin(t0) * cos(p0), cos(t0), sin(t0) * sin(p0)},
+                    {sin(t1) * cos(p0), cos(t1), sin(t1) * sin(p0)},
+                    {sin(t1) * cos(p1), cos(t1), sin(t1) * sin(p1)},
+                    {sin(t0) * cos(p1), cos(t0), sin(t0) * sin(p1)},
+                };
+                int tri[6] = {0, 1, 2, 0, 2, 3};
+                for (int k = 0; k < 6; k++, v++) {
+                    double *p = q[tri[k]];
+                    GLfloat r[10] = {0.2f + 0.35f * (float)(1.0 + p[1]), 0.5f, 0.9f - 0.3f * (float)(1.0 + p[1]),
+                                     1.0f, (float)p[0], (float)p[1], (float)p[2],
+                                     (float)(1.2 * p[0]), (float)(1.2 * p[1]), (float)(1.2 * p[2])};
+                    for (int c = 0; c < 10; c++) record[v][c] = r[c];
+                }
+            }
+        }
     }
     clearColor(0.1f, 0.1f, 0.15f, 1.0f);
     enable(GL_DEPTH_TEST);
@@ -182,6 +216,13 @@ int main(int argc, char **argv) {
             disable(GL_BLEND);
             enable(GL_LIGHTING);
             popMatrix();
+        } else if (arrays) {
+            interleavedArrays(GL_C4F_N3F_V3F, 0, record);
+            drawArrays(GL_TRIANGLES, 0, VERTS);
+            disable(GL_LIGHTING);
+            color3f(0.2f, 0.7f, 0.6f);
+            rectf(1.0f, -2.2f, 2.0f, -1.4f);
+            enable(GL_LIGHTING);
         } else {
             ball();
         }
