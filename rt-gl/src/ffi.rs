@@ -233,7 +233,7 @@ intercept! {
     glClear(mask: u32) { with_recorder(|r| r.clear(mask)) }
     glEnable(cap: u32) { rec(Command::Enable(cap)) }
     glPolygonMode(face: u32, mode: u32) { let _ = face; if mode != 0x1B02 { unsupported("glPolygonMode(GL_LINE|GL_POINT)") } }
-    glFrontFace(mode: u32) { if mode == 0x0900 { unsupported("glFrontFace(GL_CW)") } }
+    glFrontFace(mode: u32) { rec(Command::FrontFace(mode)) }
     glRectf(x1: f32, y1: f32, x2: f32, y2: f32) { rect(x1, y1, x2, y2) }
     glRectd(x1: f64, y1: f64, x2: f64, y2: f64) { rect(x1 as f32, y1 as f32, x2 as f32, y2 as f32) }
     glRecti(x1: i32, y1: i32, x2: i32, y2: i32) { rect(x1 as f32, y1 as f32, x2 as f32, y2 as f32) }

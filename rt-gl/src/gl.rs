@@ -29,6 +29,7 @@ pub const NORMALIZE: u32 = 0x0BA1;
 pub const RESCALE_NORMAL: u32 = 0x803A;
 pub const COLOR_MATERIAL: u32 = 0x0B57;
 
+pub const CW: u32 = 0x0900;
 pub const FLAT: u32 = 0x1D00;
 pub const SMOOTH: u32 = 0x1D01;
 

@@ -309,6 +309,16 @@ fn interleaved_arrays_and_rects_are_traced() {
     private_gl_frames_match_the_raster("arrays", &["arrays"]);
 }
 
+/// A ball wound clockwise under `glFrontFace(GL_CW)` and two-sided
+/// lighting: its outside is its front. rt-gl took counter-clockwise as
+/// front always, lit the outside as back faces (normals flipped: dark);
+/// now every frame agrees with Mesa.
+#[test]
+#[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
+fn clockwise_front_faces_are_lit_as_front() {
+    private_gl_frames_match_the_raster("cw", &["cw"]);
+}
+
 /// Runs the private-GL program with `args` after the frame count; every
 /// frame traced, each agreeing with Mesa's raster.
 fn private_gl_frames_match_the_raster(name: &str, args: &[&str]) {

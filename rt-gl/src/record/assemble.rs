@@ -46,6 +46,9 @@ impl Recorder {
             }
             _ => Vec::new(),
         };
+        // Clockwise front faces: each triangle reversed, so its geometric
+        // normal points where GL's front does.
+        let cw = self.front_cw;
         let (g, to_local, n_to_local) = match &mut self.capture {
             Some(c) => (&mut c.geometry, c.to_local, c.normal_to_local),
             None => (&mut self.frame.immediate, Mat4::IDENTITY, Mat3::IDENTITY),
@@ -60,7 +63,7 @@ impl Recorder {
         let n = verts.len() as u32;
         let v = |i: u32| base + i;
         let mut tri = |a: u32, b: u32, c: u32, provoking: u32| {
-            g.triangles.push([v(a), v(b), v(c)]);
+            g.triangles.push(if cw { [v(a), v(c), v(b)] } else { [v(a), v(b), v(c)] });
             g.triangle_info.push((s, v(provoking)));
         };
         match mode {

@@ -13,6 +13,8 @@ pub(super) struct Inherited {
     pub(super) color: Vec4,
     pub(super) normal: Vec3,
     pub(super) shading: Shading,
+    /// Clockwise front faces (`glFrontFace(GL_CW)`).
+    pub(super) front_cw: bool,
     /// Definitions seen (lists that call others).
     generation: u64,
 }
@@ -29,7 +31,13 @@ impl Recorder {
     /// The state a cached draw inherits; `generation`: the list
     /// definitions it depends on (0: none).
     pub(super) fn inherited(&self, generation: u64) -> Inherited {
-        Inherited { color: self.color, normal: self.normal, shading: self.shading(), generation }
+        Inherited {
+            color: self.color,
+            normal: self.normal,
+            shading: self.shading(),
+            front_cw: self.front_cw,
+            generation,
+        }
     }
 
     /// Runs `f` with its geometry recorded in the entry space of the

@@ -43,6 +43,8 @@ pub enum Command {
     ColorMaterial(u32, u32),
     /// `glShadeModel`.
     ShadeModel(u32),
+    /// `glFrontFace`: which winding faces front (`GL_CCW`, `GL_CW`).
+    FrontFace(u32),
     /// `glPointSize` (pixels).
     PointSize(f32),
     /// `glLineWidth` (pixels).

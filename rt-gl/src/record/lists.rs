@@ -44,6 +44,7 @@ struct Overrides {
     shininess: bool,
     lit: bool,
     flat: bool,
+    front: bool,
 }
 
 impl Overrides {
@@ -69,6 +70,7 @@ impl Overrides {
                 },
                 Command::Enable(gl::LIGHTING) | Command::Disable(gl::LIGHTING) => o.lit = true,
                 Command::ShadeModel(_) => o.flat = true,
+                Command::FrontFace(_) => o.front = true,
                 // Colour material ties colour and material together: keep
                 // everything in the key.
                 Command::Enable(gl::COLOR_MATERIAL) | Command::ColorMaterial(..) => {
@@ -112,6 +114,9 @@ impl Overrides {
         }
         if self.flat {
             key.shading.flat = false;
+        }
+        if self.front {
+            key.front_cw = false;
         }
         key
     }

@@ -63,6 +63,8 @@ pub struct Recorder {
     /// Per draw shape ([`DrawKey::shape`]): the key of its latest entry in
     /// `draw_cache`, whose BVHs the next recording of the shape refits.
     pub(super) draw_shapes: HashMap<DrawKey, DrawKey>,
+    /// `glFrontFace(GL_CW)`: clockwise triangles face front.
+    pub(super) front_cw: bool,
     /// What has been done so far.
     pub counters: Counters,
     /// GL features the program used that the trace does not honour, by
@@ -112,6 +114,7 @@ impl Recorder {
             arrays: ArrayState::default(),
             draw_cache: HashMap::new(),
             draw_shapes: HashMap::new(),
+            front_cw: false,
             counters: Counters::default(),
             unsupported: BTreeMap::new(),
         }
@@ -273,6 +276,7 @@ impl Recorder {
                 }
             }
             Command::ShadeModel(m) => self.flat = m == gl::FLAT,
+            Command::FrontFace(m) => self.front_cw = m == gl::CW,
             Command::PointSize(s) => {
                 if s > 0.0 && s.is_finite() {
                     self.point_size = s;

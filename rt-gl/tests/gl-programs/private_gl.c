@@ -19,6 +19,9 @@
  *                       array (glInterleavedArrays GL_C4F_N3F_V3F, colour
  *                       varying with height, glDrawArrays) beside a panel
  *                       drawn with glRectf.
+ *                       With `cw`, the ball is wound clockwise under
+ *                       glFrontFace(GL_CW) and two-sided lighting: its
+ *                       outside is its front.
  *
  * Build: cc -O2 -o private_gl private_gl.c -lX11 -ldl -lm
  */
@@ -33,6 +36,7 @@
 
 typedef void (*fn)(void);
 /* The entry points ball() draws with (set in main). */
+static int clockwise;
 static void (*p_begin)(GLenum), (*p_end)(void), (*p_color3f)(GLfloat, GLfloat, GLfloat),
     (*p_normal3f)(GLfloat, GLfloat, GLfloat), (*p_vertex3f)(GLfloat, GLfloat, GLfloat);
 
@@ -51,7 +55,8 @@ static void ball(void) {
                 {sin(t1) * cos(p1), cos(t1), sin(t1) * sin(p1)},
                 {sin(t0) * cos(p1), cos(t0), sin(t0) * sin(p1)},
             };
-            int tri[6] = {0, 1, 2, 0, 2, 3};
+            int ccw[6] = {0, 1, 2, 0, 2, 3}, cw[6] = {0, 2, 1, 0, 3, 2};
+            int *tri = clockwise ? cw : ccw;
             for (int k = 0; k < 6; k++) {
                 double *p = v[tri[k]];
                 p_normal3f(p[0], p[1], p[2]);
@@ -80,6 +85,7 @@ int main(int argc, char **argv) {
     int set_viewport = !(argc >= 3 && strcmp(argv[2], "noviewport") == 0);
     int shadow = argc >= 3 && strcmp(argv[2], "shadow") == 0;
     int arrays = argc >= 3 && strcmp(argv[2], "arrays") == 0;
+    clockwise = argc >= 3 && strcmp(argv[2], "cw") == 0;
     void *gl = dlopen("libGL.so.1", RTLD_NOW | RTLD_LOCAL);
     if (!gl) {
         fprintf(stderr, "private_gl: %s\n", dlerror());
@@ -147,7 +153,13 @@ int main(int argc, char **argv) {
     void (*interleavedArrays)(GLenum, GLsizei, const void *) = (void *)need("glInterleavedArrays");
     void (*drawArrays)(GLenum, GLint, GLsizei) = (void *)need("glDrawArrays");
     void (*rectf)(GLfloat, GLfloat, GLfloat, GLfloat) = (void *)need("glRectf");
+    void (*frontFace)(GLenum) = (void *)need("glFrontFace");
+    void (*lightModeli)(GLenum, GLint) = (void *)need("glLightModeli");
 
+    if (clockwise) {
+        frontFace(GL_CW);
+        lightModeli(GL_LIGHT_MODEL_TWO_SIDE, 1);
+    }
     p_begin = begin, p_end = end, p_color3f = color3f, p_normal3f = normal3f,
     p_vertex3f = vertex3f;
     if (set_viewport) viewport(0, 0, 256, 256);
