@@ -378,6 +378,37 @@ pub unsafe extern "C" fn glXSwapBuffers(dpy: *mut c_void, drawable: u64) {
     unsafe { crate::real::glXSwapBuffers(dpy, drawable) }
 }
 
+/// `eglSwapBuffers`: as [`glXSwapBuffers`], for programs that make their
+/// context with EGL.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eglSwapBuffers(dpy: *mut c_void, surface: *mut c_void) -> u32 {
+    crate::present::swap_frame();
+    // SAFETY: the program's own arguments, forwarded.
+    unsafe { crate::real::eglSwapBuffers(dpy, surface) }
+}
+
+/// `eglGetProcAddress`: our entry points for the names we record (GL's
+/// and `eglSwapBuffers`), the real EGL's for the rest.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn eglGetProcAddress(name: *const u8) -> Option<unsafe extern "C" fn()> {
+    if name.is_null() {
+        return None;
+    }
+    // SAFETY: EGL passes a NUL-terminated name.
+    let bytes = unsafe { CStr::from_ptr(name.cast()) }.to_bytes();
+    if bytes == b"eglSwapBuffers" {
+        // SAFETY: called back only through its own signature.
+        return Some(unsafe {
+            core::mem::transmute::<
+                unsafe extern "C" fn(*mut c_void, *mut c_void) -> u32,
+                unsafe extern "C" fn(),
+            >(eglSwapBuffers)
+        });
+    }
+    // SAFETY: forwarded as given.
+    lookup(bytes).or_else(|| unsafe { crate::real::eglGetProcAddress(name) })
+}
+
 /// `glXGetProcAddress`: our entry points for the names we record, the
 /// real GL's for the rest.
 #[unsafe(no_mangle)]

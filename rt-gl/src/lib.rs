@@ -4,9 +4,9 @@
 //! loaded with `LD_PRELOAD`, rt-gl stands between the program and the
 //! system's GL: it records the fixed-function geometry the program sends
 //! (immediate mode, display lists, matrices, lights, materials), forwards
-//! every call to the real GL, and at each `glXSwapBuffers` replaces the
-//! frame with a ray-traced one, written into the back buffer just before
-//! the real swap.
+//! every call to the real GL, and at each `glXSwapBuffers` or
+//! `eglSwapBuffers` replaces the frame with a ray-traced one, written into
+//! the back buffer just before the real swap.
 //!
 //! ```sh
 //! cargo build --release -p rt-gl

@@ -1,7 +1,7 @@
 //! The real GL behind the interposer: functions looked up with
 //! `dlsym(RTLD_NEXT, name)`, i.e. in the libraries loaded after this one
-//! (the system's libGL), and where the program never linked libGL but
-//! opened it privately (`dlopen` with `RTLD_LOCAL`, as Qt's GLX plugin
+//! (the system's libGL and libEGL), and where the program never linked
+//! them but opened them privately (`dlopen` with `RTLD_LOCAL`, as Qt's GLX plugin
 //! does) in that library itself, opened by name. A function found in
 //! neither is missing: its calls do nothing, it is named once on stderr,
 //! and `glXGetProcAddress` answers null for it, as GL does for an unknown
@@ -47,15 +47,16 @@ fn lookup(name: &CStr) -> usize {
     if p != 0 {
         return p;
     }
-    if let Some(gl) = system_gl() {
+    let egl = name.to_bytes().starts_with(b"egl");
+    if let Some(lib) = if egl { system_egl() } else { system_gl() } {
         // SAFETY: a handle from dlopen and a NUL-terminated name; the
-        // lookup is in libGL and its dependencies, not in this library.
-        let p = unsafe { libc::dlsym(gl as *mut c_void, name.as_ptr()) } as usize;
+        // lookup is in that library and its dependencies, not this one.
+        let p = unsafe { libc::dlsym(lib as *mut c_void, name.as_ptr()) } as usize;
         if p != 0 {
             return p;
         }
     }
-    if name.to_bytes().starts_with(b"glX") {
+    if egl || name.to_bytes().starts_with(b"glX") {
         return 0;
     }
     // SAFETY: a NUL-terminated name.
@@ -66,8 +67,19 @@ fn lookup(name: &CStr) -> usize {
 /// loaded (privately or not), else opened here; `None` if there is none.
 fn system_gl() -> Option<usize> {
     static GL: OnceLock<usize> = OnceLock::new();
-    let h = *GL.get_or_init(|| {
-        for name in [c"libGL.so.1", c"libGL.so"] {
+    system_library(&GL, &[c"libGL.so.1", c"libGL.so"])
+}
+
+/// The system's libEGL, as [`system_gl`] finds libGL.
+fn system_egl() -> Option<usize> {
+    static EGL: OnceLock<usize> = OnceLock::new();
+    system_library(&EGL, &[c"libEGL.so.1", c"libEGL.so"])
+}
+
+/// The first of `names` already loaded, else the first that opens.
+fn system_library(cell: &OnceLock<usize>, names: &[&CStr]) -> Option<usize> {
+    let h = *cell.get_or_init(|| {
+        for name in names {
             for flags in [
                 libc::RTLD_LAZY | libc::RTLD_LOCAL | libc::RTLD_NOLOAD,
                 libc::RTLD_LAZY | libc::RTLD_LOCAL,
@@ -130,6 +142,8 @@ real_fns! {
     glGetBooleanv(pname: u32, data: *mut u8);
     glGetIntegerv(pname: u32, data: *mut i32);
     glXSwapBuffers(dpy: *mut c_void, drawable: u64);
+    eglSwapBuffers(dpy: *mut c_void, surface: *mut c_void) -> u32;
+    eglGetProcAddress(name: *const u8) -> Option<unsafe extern "C" fn()>;
     glXGetProcAddress(name: *const u8) -> Option<unsafe extern "C" fn()>;
     glXGetProcAddressARB(name: *const u8) -> Option<unsafe extern "C" fn()>;
 }

@@ -1,9 +1,11 @@
-//! Real programs under rt-gl: the C test program and Debian's `glxgears`,
-//! run under `xvfb-run` with Mesa's software GL and `LD_PRELOAD`, each
-//! frame's ray-traced image compared with what Mesa rasterized for it.
+//! Real programs under rt-gl: the C test programs (`tests/gl-programs/`:
+//! every recorded path; a toolkit-style private libGL; EGL) and Debian's
+//! `glxgears`, run under `xvfb-run` with Mesa's software GL and
+//! `LD_PRELOAD`, each frame's ray-traced image compared with what Mesa
+//! rasterized for it.
 //!
-//! They need `xvfb-run`, a C compiler, libGL/libX11 headers and
-//! `glxgears` (Debian: `xvfb xauth mesa-utils libgl-dev libx11-dev`), so
+//! They need `xvfb-run`, a C compiler, GL/EGL/X11 headers and `glxgears`
+//! (Debian: `xvfb xauth mesa-utils libgl-dev libegl-dev libx11-dev`), so
 //! they are `#[ignore]`d in the plain test run; CI installs those and runs
 //! `cargo test --release -p rt-gl -- --ignored`.
 
@@ -43,7 +45,7 @@ fn tool(name: &str) -> PathBuf {
     match out {
         Ok(o) if o.status.success() => PathBuf::from(String::from_utf8_lossy(&o.stdout).trim()),
         _ => panic!(
-            "{name} not found: install xvfb xauth mesa-utils libgl-dev libx11-dev (Debian) to run these tests"
+            "{name} not found: install xvfb xauth mesa-utils libgl-dev libegl-dev libx11-dev (Debian) to run these tests"
         ),
     }
 }
@@ -83,6 +85,23 @@ fn private_gl_program(dir: &Path) -> PathBuf {
         .arg(&exe)
         .arg(&src)
         .args(["-lX11", "-ldl", "-lm"])
+        .status()
+        .expect("run cc");
+    assert!(status.success(), "cc failed on {}", src.display());
+    exe
+}
+
+/// Compiles the EGL program (context and presentation through EGL on
+/// X11, no GLX).
+fn egl_program(dir: &Path) -> PathBuf {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gl-programs/egl_gl.c");
+    let exe = dir.join("egl_gl");
+    let status = Command::new(tool("cc"))
+        .arg("-O2")
+        .arg("-o")
+        .arg(&exe)
+        .arg(&src)
+        .args(["-lEGL", "-lGL", "-lX11", "-lm"])
         .status()
         .expect("run cc");
     assert!(status.success(), "cc failed on {}", src.display());
@@ -385,5 +404,40 @@ fn a_planar_shadow_is_left_out_not_the_frame() {
     let c = counters(&dir);
     assert_eq!(c["left_out"], 1, "{c:?}");
     assert_eq!(c["unsupported.GL_BLEND"], frames as u64, "{c:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A program that makes its context with EGL and presents with
+/// `eglSwapBuffers`: not one frame was traced before (rt-gl hooked only
+/// GLX); now every frame is, agreeing with Mesa's raster.
+#[test]
+#[ignore = "needs xvfb-run, cc, libGL, libEGL and libX11 headers: CI runs it with --ignored"]
+fn an_egl_program_is_traced() {
+    let dir = scratch("egl");
+    let exe = egl_program(&dir);
+    let frames = 5;
+    let out = Command::new(tool("xvfb-run"))
+        .args(["-a", "-s", "-screen 0 640x480x24"])
+        .arg(&exe)
+        .arg(frames.to_string())
+        .env("LD_PRELOAD", interposer())
+        .env("RT_GL_DUMP", &dir)
+        .env("RT_GL_DUMP_RASTER", "1")
+        .output()
+        .expect("run xvfb-run");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(stdout.contains(&format!("frames {frames}")), "{stdout}");
+    for f in 0..frames {
+        let (agree, diff) = compare(
+            &dir.join(format!("raster-{f:04}.png")),
+            &dir.join(format!("rt-{f:04}.png")),
+            [26, 26, 38],
+        );
+        assert!(agree >= 0.99, "frame {f}: coverage agrees on {:.2} %", 100.0 * agree);
+        assert!(diff <= 4.0, "frame {f}: mean colour difference {diff:.2}/255");
+    }
+    assert_eq!(counters(&dir)["frames"], frames as u64);
     let _ = std::fs::remove_dir_all(&dir);
 }
