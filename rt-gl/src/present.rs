@@ -35,11 +35,12 @@ fn present_frame(buffer: u32) {
         if r.compiling_only() {
             return None;
         }
-        let frame = r.end_frame();
+        let mut frame = r.end_frame();
         let counters = r.counters;
         let unsupported: Vec<(&'static str, u64)> =
             r.unsupported.iter().map(|(k, v)| (*k, *v)).collect();
-        let state = (r.lighting.clone(), r.projection(), r.viewport, r.clear_color);
+        let lighting = frame.lighting.take().unwrap_or_else(|| r.lighting.clone());
+        let state = (lighting, r.projection(), r.viewport, r.clear_color);
         Some((frame, state, counters, unsupported))
     })
     .flatten();

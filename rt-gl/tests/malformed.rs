@@ -69,7 +69,7 @@ fn render(frame: FrameDraws, opts: &Options) -> Result<Image, RenderError> {
 }
 
 fn immediate(g: Geometry) -> FrameDraws {
-    FrameDraws { immediate: g, instances: Vec::new() }
+    FrameDraws { immediate: g, ..FrameDraws::default() }
 }
 
 /// `g` as one recording, placed twice (once moved aside).
@@ -81,6 +81,7 @@ fn instanced(g: Geometry) -> FrameDraws {
             (Arc::clone(&rec), Mat4::IDENTITY),
             (rec, translate(Vec3::new(0.0, 0.0, -4.0))),
         ],
+        lighting: None,
     }
 }
 

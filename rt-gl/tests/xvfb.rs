@@ -338,6 +338,16 @@ fn clockwise_front_faces_are_lit_as_front() {
     private_gl_frames_match_the_raster("cw", &["cw"]);
 }
 
+/// A ball drawn lit, then lighting and its light turned off before the
+/// swap (as a viewer does before its 2-D overlays): GL lit the ball when
+/// it was drawn. rt-gl took the lights at the swap and showed it dark;
+/// now it takes those of the frame's last lit draw.
+#[test]
+#[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
+fn lights_turned_off_before_the_swap_still_light_the_frame() {
+    private_gl_frames_match_the_raster("lightsoff", &["lightsoff"]);
+}
+
 /// Runs the private-GL program with `args` after the frame count; every
 /// frame traced, each agreeing with Mesa's raster.
 fn private_gl_frames_match_the_raster(name: &str, args: &[&str]) {

@@ -46,6 +46,9 @@ impl Recorder {
             }
             _ => Vec::new(),
         };
+        if shading.lit && self.capture.is_none() && self.state_only == 0 {
+            self.frame.lighting = Some(self.lighting.clone());
+        }
         // Clockwise front faces: each triangle reversed, so its geometric
         // normal points where GL's front does.
         let cw = self.front_cw;

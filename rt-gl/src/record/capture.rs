@@ -71,6 +71,9 @@ impl Recorder {
     /// Adds an instance of cached geometry to the frame.
     pub(super) fn instance(&mut self, geometry: Arc<Recorded>, mv: Mat4) {
         if !geometry.geometry().is_empty() && self.state_only == 0 {
+            if geometry.geometry().shadings.iter().any(|s| s.lit) {
+                self.frame.lighting = Some(self.lighting.clone());
+            }
             self.frame.instances.push((geometry, mv));
         }
     }

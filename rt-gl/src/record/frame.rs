@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use glam::Mat4;
 
-use super::{Geometry, GeometryError, Recorded};
+use super::{Geometry, GeometryError, Lighting, Recorded};
 
 /// One frame's draws: immediate geometry in eye space and instances of
 /// cached display lists.
@@ -14,6 +14,10 @@ pub struct FrameDraws {
     pub immediate: Geometry,
     /// Cached list geometry and the modelview of each call.
     pub instances: Vec<(Arc<Recorded>, Mat4)>,
+    /// The lights in force at the frame's last lit draw (`None`: nothing
+    /// lit was drawn): a program may turn its lights off after its 3-D
+    /// pass, before the swap, as GL only applies them per draw.
+    pub lighting: Option<Lighting>,
 }
 
 impl FrameDraws {

@@ -22,6 +22,9 @@
  *                       With `cw`, the ball is wound clockwise under
  *                       glFrontFace(GL_CW) and two-sided lighting: its
  *                       outside is its front.
+ *                       With `lightsoff`, lighting and the light are
+ *                       turned off after the ball is drawn, before the
+ *                       swap (as a viewer does before its 2-D overlays).
  *
  * Build: cc -O2 -o private_gl private_gl.c -lX11 -ldl -lm
  */
@@ -86,6 +89,7 @@ int main(int argc, char **argv) {
     int shadow = argc >= 3 && strcmp(argv[2], "shadow") == 0;
     int arrays = argc >= 3 && strcmp(argv[2], "arrays") == 0;
     clockwise = argc >= 3 && strcmp(argv[2], "cw") == 0;
+    int lightsoff = argc >= 3 && strcmp(argv[2], "lightsoff") == 0;
     void *gl = dlopen("libGL.so.1", RTLD_NOW | RTLD_LOCAL);
     if (!gl) {
         fprintf(stderr, "private_gl: %s\n", dlerror());
@@ -238,7 +242,15 @@ int main(int argc, char **argv) {
         } else {
             ball();
         }
+        if (lightsoff) {
+            disable(GL_LIGHT0);
+            disable(GL_LIGHTING);
+        }
         swapBuffers(dpy, win);
+        if (lightsoff) {
+            enable(GL_LIGHTING);
+            enable(GL_LIGHT0);
+        }
         finish();
     }
     printf("frames %d\n", frames);
