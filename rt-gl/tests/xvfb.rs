@@ -57,55 +57,58 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
-/// Compiles the C test program.
-fn scenes_program(dir: &Path) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gl-programs/scenes.c");
-    let exe = dir.join("scenes");
+/// Compiles `tests/gl-programs/NAME.c` into `dir`, linked with `libs`.
+/// The programs: `scenes` (every path the interposer records),
+/// `private_gl` (libGL opened privately with `RTLD_LOCAL`, never linked,
+/// every entry point from `glXGetProcAddressARB`, as Qt's GLX plugin
+/// does), `egl_gl` (context and presentation through EGL on X11).
+fn program(dir: &Path, name: &str, libs: &[&str]) -> PathBuf {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/gl-programs/{name}.c"));
+    let exe = dir.join(name);
     let status = Command::new(tool("cc"))
         .arg("-O2")
         .arg("-o")
         .arg(&exe)
         .arg(&src)
-        .args(["-lGL", "-lX11", "-lm"])
+        .args(libs)
         .status()
         .expect("run cc");
     assert!(status.success(), "cc failed on {}", src.display());
     exe
 }
 
-/// Compiles the program that opens libGL privately (`dlopen` with
-/// `RTLD_LOCAL`, never linked) and takes every entry point from
-/// `glXGetProcAddressARB`, as Qt's GLX plugin does.
-fn private_gl_program(dir: &Path) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gl-programs/private_gl.c");
-    let exe = dir.join("private_gl");
-    let status = Command::new(tool("cc"))
-        .arg("-O2")
-        .arg("-o")
-        .arg(&exe)
-        .arg(&src)
-        .args(["-lX11", "-ldl", "-lm"])
-        .status()
-        .expect("run cc");
-    assert!(status.success(), "cc failed on {}", src.display());
-    exe
+/// Runs `exe args…` under `xvfb-run` with the interposer, dumping frames
+/// into `dir` (and Mesa's raster of each); `(stdout, stderr)` of a run
+/// that must succeed.
+fn run_traced(exe: &Path, args: &[&str], dir: &Path) -> (String, String) {
+    let out = Command::new(tool("xvfb-run"))
+        .args(["-a", "-s", "-screen 0 640x480x24"])
+        .arg(exe)
+        .args(args)
+        .env("LD_PRELOAD", interposer())
+        .env("RT_GL_DUMP", dir)
+        .env("RT_GL_DUMP_RASTER", "1")
+        .output()
+        .expect("run xvfb-run");
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "exit {:?}: {stdout}\n{stderr}", out.status.code());
+    (stdout, stderr)
 }
 
-/// Compiles the EGL program (context and presentation through EGL on
-/// X11, no GLX).
-fn egl_program(dir: &Path) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gl-programs/egl_gl.c");
-    let exe = dir.join("egl_gl");
-    let status = Command::new(tool("cc"))
-        .arg("-O2")
-        .arg("-o")
-        .arg(&exe)
-        .arg(&src)
-        .args(["-lEGL", "-lGL", "-lX11", "-lm"])
-        .status()
-        .expect("run cc");
-    assert!(status.success(), "cc failed on {}", src.display());
-    exe
+/// Frames `0..frames` in `dir`: each traced, coverage agreeing with Mesa's
+/// raster on ≥ 99 % of the pixels and colours within 4/255 on average
+/// (background: the programs' clear colour (0.1, 0.1, 0.15)).
+fn frames_match_the_raster(dir: &Path, frames: usize) {
+    for f in 0..frames {
+        let (agree, diff) = compare(
+            &dir.join(format!("raster-{f:04}.png")),
+            &dir.join(format!("rt-{f:04}.png")),
+            [26, 26, 38],
+        );
+        assert!(agree >= 0.99, "frame {f}: coverage agrees on {:.2} %", 100.0 * agree);
+        assert!(diff <= 4.0, "frame {f}: mean colour difference {diff:.2}/255");
+    }
 }
 
 /// RGBA rows, top first.
@@ -165,23 +168,12 @@ fn counters(dir: &Path) -> std::collections::HashMap<String, u64> {
 #[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
 fn test_program_frames_match_the_raster() {
     let dir = scratch("scenes");
-    let exe = scenes_program(&dir);
+    let exe = program(&dir, "scenes", &["-lGL", "-lX11", "-lm"]);
     let frames = 20;
-    let out = Command::new(tool("xvfb-run"))
-        .args(["-a", "-s", "-screen 0 640x480x24"])
-        .arg(&exe)
-        .arg(frames.to_string())
-        .env("LD_PRELOAD", interposer())
-        .env("RT_GL_DUMP", &dir)
-        .env("RT_GL_DUMP_RASTER", "1")
-        .output()
-        .expect("run xvfb-run");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    let (stdout, stderr) = run_traced(&exe, &[&frames.to_string()], &dir);
     assert!(stdout.contains(&format!("frames {frames}")), "{stdout}");
     // The clear colour (0.1, 0.1, 0.15).
     let bg = [26, 26, 38];
-    let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(stderr.matches("left as rasterized").count(), 1, "{stderr}");
     assert!(stderr.contains("projection matrix is singular"), "{stderr}");
     for f in 0..frames {
@@ -222,20 +214,9 @@ fn test_program_frames_match_the_raster() {
 #[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
 fn waving_vbo_is_refitted_every_frame() {
     let dir = scratch("wave");
-    let exe = scenes_program(&dir);
+    let exe = program(&dir, "scenes", &["-lGL", "-lX11", "-lm"]);
     let frames = 12;
-    let out = Command::new(tool("xvfb-run"))
-        .args(["-a", "-s", "-screen 0 640x480x24"])
-        .arg(&exe)
-        .args(["wave", &frames.to_string()])
-        .env("LD_PRELOAD", interposer())
-        .env("RT_GL_DUMP", &dir)
-        .env("RT_GL_DUMP_RASTER", "1")
-        .output()
-        .expect("run xvfb-run");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stdout}\n{stderr}");
+    let (stdout, stderr) = run_traced(&exe, &["wave", &frames.to_string()], &dir);
     assert!(stdout.contains(&format!("frames {frames}")), "{stdout}");
     assert!(!stderr.contains("left as rasterized"), "{stderr}");
     let bg = [26, 26, 38];
@@ -352,32 +333,12 @@ fn lights_turned_off_before_the_swap_still_light_the_frame() {
 /// frame traced, each agreeing with Mesa's raster.
 fn private_gl_frames_match_the_raster(name: &str, args: &[&str]) {
     let dir = scratch(name);
-    let exe = private_gl_program(&dir);
+    let exe = program(&dir, "private_gl", &["-lX11", "-ldl", "-lm"]);
     let frames = 6;
-    let out = Command::new(tool("xvfb-run"))
-        .args(["-a", "-s", "-screen 0 640x480x24"])
-        .arg(&exe)
-        .arg(frames.to_string())
-        .args(args)
-        .env("LD_PRELOAD", interposer())
-        .env("RT_GL_DUMP", &dir)
-        .env("RT_GL_DUMP_RASTER", "1")
-        .output()
-        .expect("run xvfb-run");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "exit {:?}: {stdout}\n{stderr}", out.status.code());
+    let (stdout, stderr) = run_traced(&exe, &[&[&*frames.to_string()], args].concat(), &dir);
     assert!(stdout.contains(&format!("frames {frames}")), "{stdout}");
     assert!(!stderr.contains("is not in the system's GL"), "{stderr}");
-    for f in 0..frames {
-        let (agree, diff) = compare(
-            &dir.join(format!("raster-{f:04}.png")),
-            &dir.join(format!("rt-{f:04}.png")),
-            [26, 26, 38],
-        );
-        assert!(agree >= 0.99, "frame {f}: coverage agrees on {:.2} %", 100.0 * agree);
-        assert!(diff <= 4.0, "frame {f}: mean colour difference {diff:.2}/255");
-    }
+    frames_match_the_raster(&dir, frames);
     assert_eq!(counters(&dir)["frames"], frames as u64);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -391,19 +352,9 @@ fn private_gl_frames_match_the_raster(name: &str, args: &[&str]) {
 #[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
 fn a_planar_shadow_is_left_out_not_the_frame() {
     let dir = scratch("shadow");
-    let exe = private_gl_program(&dir);
+    let exe = program(&dir, "private_gl", &["-lX11", "-ldl", "-lm"]);
     let frames = 4;
-    let out = Command::new(tool("xvfb-run"))
-        .args(["-a", "-s", "-screen 0 640x480x24"])
-        .arg(&exe)
-        .args([&frames.to_string(), "shadow"])
-        .env("LD_PRELOAD", interposer())
-        .env("RT_GL_DUMP", &dir)
-        .output()
-        .expect("run xvfb-run");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stdout}\n{stderr}");
+    let (stdout, stderr) = run_traced(&exe, &[&frames.to_string(), "shadow"], &dir);
     assert!(stdout.contains(&format!("frames {frames}")), "{stdout}");
     for f in 0..frames {
         assert!(dir.join(format!("rt-{f:04}.png")).exists(), "frame {f} not traced: {stderr}");
@@ -424,30 +375,11 @@ fn a_planar_shadow_is_left_out_not_the_frame() {
 #[ignore = "needs xvfb-run, cc, libGL, libEGL and libX11 headers: CI runs it with --ignored"]
 fn an_egl_program_is_traced() {
     let dir = scratch("egl");
-    let exe = egl_program(&dir);
+    let exe = program(&dir, "egl_gl", &["-lEGL", "-lGL", "-lX11", "-lm"]);
     let frames = 5;
-    let out = Command::new(tool("xvfb-run"))
-        .args(["-a", "-s", "-screen 0 640x480x24"])
-        .arg(&exe)
-        .arg(frames.to_string())
-        .env("LD_PRELOAD", interposer())
-        .env("RT_GL_DUMP", &dir)
-        .env("RT_GL_DUMP_RASTER", "1")
-        .output()
-        .expect("run xvfb-run");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stdout}\n{stderr}");
+    let (stdout, _) = run_traced(&exe, &[&frames.to_string()], &dir);
     assert!(stdout.contains(&format!("frames {frames}")), "{stdout}");
-    for f in 0..frames {
-        let (agree, diff) = compare(
-            &dir.join(format!("raster-{f:04}.png")),
-            &dir.join(format!("rt-{f:04}.png")),
-            [26, 26, 38],
-        );
-        assert!(agree >= 0.99, "frame {f}: coverage agrees on {:.2} %", 100.0 * agree);
-        assert!(diff <= 4.0, "frame {f}: mean colour difference {diff:.2}/255");
-    }
+    frames_match_the_raster(&dir, frames);
     assert_eq!(counters(&dir)["frames"], frames as u64);
     let _ = std::fs::remove_dir_all(&dir);
 }
