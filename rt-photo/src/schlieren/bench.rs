@@ -410,7 +410,8 @@ impl SchlierenBench {
     /// tolerance the bench cannot resolve ([`SchlierenBench::skip_tolerance`]);
     /// photons whose line meets no node too rough for it (a [`BeamMask`]
     /// with one cell per film pixel) go straight without walking the tree.
-    /// With a tree built for another interpolant, traced without skipping.
+    /// `tree` bounds `field`'s own interpolant (a [`rt_volume::GridMedium`]
+    /// builds them together).
     pub(crate) fn render_grid_with(
         &self,
         field: &GridField,
@@ -420,9 +421,6 @@ impl SchlierenBench {
         pass: u64,
         seed: u64,
     ) -> Result<(), BenchError> {
-        if field.interp() != tree.interp() {
-            return self.render_with(&|o, d| trace(field, o, d, params), film, pass, seed);
-        }
         self.validate()?;
         let window = BeamWindow {
             center: self.center,

@@ -128,9 +128,7 @@ pub struct SchlierenSetup {
     pub bench: SchlierenBench,
     /// Film width and height in pixels.
     pub size: (usize, usize),
-    /// Photons per pixel asked for.
-    pub photons: u32,
-    /// The options it was set up from.
+    /// The options it was set up from (photons per pixel among them).
     pub options: SchlierenOptions,
     /// A warning about the set-up (fringes that alias), if any.
     pub warning: Option<String>,
@@ -184,7 +182,7 @@ impl SchlierenSetup {
             reconstruction: o.reconstruction,
             ..SchlierenBench::through(medium.bounds(), o.axis, mode, film_distance, params)
         };
-        Ok(Self { bench, size: (w, h), photons: o.photons, options: o.clone(), warning })
+        Ok(Self { bench, size: (w, h), options: o.clone(), warning })
     }
 
     /// Renders the image through `medium` (whole passes of a lattice of
@@ -201,7 +199,7 @@ impl SchlierenSetup {
     ) -> Result<Film, SetupError> {
         let (w, h) = self.size;
         let mut film = Film::new(w, h, Filter::Tent)?;
-        let (strata, passes) = lattice(self.photons);
+        let (strata, passes) = lattice(self.options.photons);
         let bench = SchlierenBench { strata, ..self.bench.clone() };
         let per_pass = (w * h) as u64 * u64::from(strata * strata);
         for pass in 0..passes {

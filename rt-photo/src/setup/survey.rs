@@ -63,7 +63,7 @@ impl Survey {
     /// The `q`-quantile of `|ε|`.
     #[must_use]
     pub fn magnitude(&self, q: f64) -> f64 {
-        quantile(self.eps.iter().flatten().map(|&(a, b)| hypot(a, b)).collect(), q)
+        quantile(self.eps.iter().flatten().map(|&(a, b)| math::hypot(a, b)).collect(), q)
     }
 
     /// The `q`-quantile of `|ε|` over the disturbed pixels (those
@@ -72,7 +72,7 @@ impl Survey {
     /// fill.
     #[must_use]
     pub fn disturbed_magnitude(&self, q: f64) -> f64 {
-        let all: Vec<f64> = self.eps.iter().flatten().map(|&(a, b)| hypot(a, b)).collect();
+        let all: Vec<f64> = self.eps.iter().flatten().map(|&(a, b)| math::hypot(a, b)).collect();
         let floor = 1e-3 * all.iter().copied().filter(|m| m.is_finite()).fold(0.0, f64::max);
         quantile(all.into_iter().filter(|&m| m > floor).collect(), q)
     }
@@ -107,12 +107,6 @@ impl Survey {
         }
         quantile(div, q)
     }
-}
-
-/// `√(a² + b²)` as std's `hypot` (the quantiles must not change with the
-/// float library).
-fn hypot(a: f64, b: f64) -> f64 {
-    math::hypot(a, b)
 }
 
 /// The `q`-quantile (0–1) of `values` (0 for none).

@@ -54,7 +54,6 @@ from ._volume import (
     read_volume,
 )
 from ._optics import (
-    _CUTOFFS,
     _bench,
     _dtype,
     _grey,

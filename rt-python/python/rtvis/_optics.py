@@ -57,9 +57,6 @@ def _grey(image: np.ndarray, background, dtype) -> np.ndarray:
     return np.ascontiguousarray(g / b if b > 0.0 else g, dtype=_dtype(dtype))
 
 
-_CUTOFFS = ("knife", "graded", "pinhole", "dark-field", "color", "none", "interferometry")
-
-
 def schlieren(
     volume: Volume,
     cutoff: str = "knife",

@@ -126,7 +126,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             let run = SchlierenSetup {
                 bench: b.clone(),
                 size: (size, height),
-                photons: n,
+                options: SchlierenOptions { photons: n, ..setup.options.clone() },
                 ..setup.clone()
             };
             let render = |seed: u64| -> Result<(Film, f64), String> {
