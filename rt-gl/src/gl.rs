@@ -22,6 +22,7 @@ pub const PROJECTION: u32 = 0x1701;
 pub const TEXTURE: u32 = 0x1702;
 
 pub const COLOR_BUFFER_BIT: u32 = 0x0000_4000;
+pub const DEPTH_BUFFER_BIT: u32 = 0x0000_0100;
 
 pub const LIGHTING: u32 = 0x0B50;
 pub const LIGHT0: u32 = 0x4000;
@@ -70,6 +71,8 @@ pub const VIEWPORT: u32 = 0x0BA2;
 pub const ALL_ATTRIB_BITS: u32 = 0x000F_FFFF;
 pub const CLIENT_ALL_ATTRIB_BITS: u32 = 0xFFFF_FFFF;
 pub const DEPTH_TEST: u32 = 0x0B71;
+pub const SCISSOR_TEST: u32 = 0x0C11;
+pub const GREATER: u32 = 0x0204;
 pub const TEXTURE_2D: u32 = 0x0DE1;
 pub const BLEND: u32 = 0x0BE2;
 pub const FOG: u32 = 0x0B60;

@@ -18,9 +18,11 @@
 //!   recorded once and instanced on every call, and a buffer draw whose
 //!   vertices change but whose triangles do not has its BVHs refitted,
 //!   not rebuilt ([`record::Recorded::moved`]).
-//! - [`render`]: the frame ray traced per pixel with GL's lighting
+//! - [`render`]: a pass ray traced per pixel with GL's lighting
 //!   equation (`gl` mode) or with shadows, ambient occlusion and mirror
 //!   reflections too (`rt`).
+//! - [`composite`]: a frame's passes put together as GL's depth buffer
+//!   orders draws, 2-D overlays kept as GL drew them.
 //! - The interposer itself (exported `gl*`/`glX*` symbols) is in the
 //!   `cdylib`; it never lets a panic reach the program, and any error
 //!   leaves that frame as the real GL drew it, logged once to stderr.
@@ -45,6 +47,7 @@ use std::{
     sync::{Mutex, OnceLock},
 };
 
+pub mod composite;
 mod ffi;
 pub mod gl;
 mod present;

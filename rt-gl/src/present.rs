@@ -6,6 +6,7 @@ use core::ffi::c_void;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::{
+    composite::{Content, Layer, composite, keeps_raster},
     config, gl, log_once, real,
     render::{FrameScene, Image},
     with_recorder,
@@ -35,17 +36,13 @@ fn present_frame(buffer: u32) {
         if r.compiling_only() {
             return None;
         }
-        let mut frame = r.end_frame();
-        let counters = r.counters;
+        let frame = r.end_frame();
         let unsupported: Vec<(&'static str, u64)> =
             r.unsupported.iter().map(|(k, v)| (*k, *v)).collect();
-        let lighting = frame.lighting.take().unwrap_or_else(|| r.lighting.clone());
-        let state = (lighting, r.projection(), r.viewport, r.clear_color);
-        Some((frame, state, counters, unsupported))
+        Some((frame, r.lighting.clone(), r.counters, unsupported))
     })
     .flatten();
-    let Some((frame, (lighting, projection, viewport, background), counters, unsupported)) = taken
-    else {
+    let Some((frame, lighting, counters, unsupported)) = taken else {
         return;
     };
     for (what, _) in &unsupported {
@@ -59,28 +56,84 @@ fn present_frame(buffer: u32) {
     let n = FRAME.fetch_add(1, Ordering::Relaxed);
     // A program that never calls glViewport draws in GL's initial one,
     // the drawable's size when the context was first made current.
-    let viewport = if viewport[2] > 0 && viewport[3] > 0 { viewport } else { real_viewport() };
-    let [x, y, w, h] = viewport;
-    if w <= 0 || h <= 0 {
+    let initial = std::sync::OnceLock::new();
+    let resolve = |v: [i32; 4]| {
+        if v[2] > 0 && v[3] > 0 { v } else { *initial.get_or_init(real_viewport) }
+    };
+    let passes: Vec<_> = frame
+        .passes
+        .into_iter()
+        .map(|p| (resolve(p.view.viewport), p))
+        .filter(|(v, _)| v[2] > 0 && v[3] > 0)
+        .collect();
+    let Some(window) = passes.iter().map(|(v, _)| *v).reduce(union) else {
+        return;
+    };
+    let window = clip_to_window(window);
+    if window[2] <= 0 || window[3] <= 0 {
         return;
     }
     if let (true, Some(dir)) = (cfg.dump_raster, &cfg.dump) {
-        let img = read_back(buffer, viewport);
+        let img = read_back(buffer, window);
         if let Err(e) = img.write_png(&dir.join(format!("raster-{n:04}.png"))) {
             log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
         }
     }
     let mut left_out = 0;
-    let rendered = crate::catch(|| {
-        let scene = FrameScene::build(frame)?;
-        left_out = scene.left_out();
-        let render =
-            || scene.render(&lighting, projection, w as u32, h as u32, background, &cfg.options);
-        match &cfg.pool {
-            Some(pool) => pool.install(render),
-            None => render(),
-        }
-    });
+    let mut traced = 0;
+    let layers: Vec<Layer> = passes
+        .into_iter()
+        .map(|(viewport, pass)| {
+            let overlay = pass.view.is_overlay(viewport);
+            let content = crate::catch(|| {
+                let pass_lighting = pass.draws.lighting.clone().unwrap_or_else(|| lighting.clone());
+                let scene = FrameScene::build(pass.draws)?;
+                left_out += scene.left_out();
+                let [_, _, w, h] = viewport.map(|v| v as u32);
+                let projection = pass.view.projection;
+                let work = || {
+                    if overlay {
+                        scene.coverage(projection, w, h).map(|depth| Content::Raster { depth })
+                    } else {
+                        scene
+                            .render_with_depth(
+                                &pass_lighting,
+                                projection,
+                                w,
+                                h,
+                                pass.background,
+                                &cfg.options,
+                            )
+                            .map(|(image, depth)| Content::Traced { image, depth })
+                    }
+                };
+                match &cfg.pool {
+                    Some(pool) => pool.install(work),
+                    None => work(),
+                }
+            });
+            let content = match content {
+                Some(Ok(c)) => c,
+                Some(Err(e)) => {
+                    // Once per cause.
+                    log_once(
+                        &format!("render: {e}"),
+                        &format!("a pass of frame {n} left as rasterized: {e}"),
+                    );
+                    Content::Untraced
+                }
+                None => Content::Untraced,
+            };
+            traced += usize::from(matches!(content, Content::Traced { .. }));
+            Layer {
+                viewport,
+                depth_test: pass.view.depth_test,
+                depth_cleared: pass.depth_cleared,
+                background: pass.background,
+                content,
+            }
+        })
+        .collect();
     if left_out > 0 {
         log_once(
             "left out",
@@ -90,41 +143,62 @@ fn present_frame(buffer: u32) {
         );
     }
     if let Some(dir) = &cfg.dump {
-        write_counters(dir, &counters, left_out, &unsupported);
+        let passes = [("traced", traced), ("kept", layers.len() - traced)];
+        write_counters(dir, &counters, left_out, &passes, &unsupported);
     }
-    let img = match rendered {
-        Some(Ok(img)) => img,
-        Some(Err(e)) => {
-            // Once per cause.
-            log_once(&format!("render: {e}"), &format!("frame {n} left as rasterized: {e}"));
-            return;
-        }
-        None => return,
-    };
+    if traced == 0 {
+        // Nothing traced: the frame stays exactly as GL drew it.
+        return;
+    }
+    let img = composite(window, &layers);
+    let keep = keeps_raster(&img);
     // SAFETY: `img` holds w·h RGBA pixels; the state touched is restored.
-    unsafe { draw(&img, x, y, buffer) };
-    if let Some((dir, Err(e))) =
-        cfg.dump.as_ref().map(|d| (d, img.write_png(&d.join(format!("rt-{n:04}.png")))))
-    {
-        log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
+    unsafe { draw(&img, window[0], window[1], keep) };
+    if let Some(dir) = &cfg.dump {
+        // What the window shows: GL's overlays read back where kept.
+        let shown = if keep { read_back(buffer, window) } else { img };
+        if let Err(e) = shown.write_png(&dir.join(format!("rt-{n:04}.png"))) {
+            log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
+        }
     }
     if cfg.stats {
         eprintln!("rt-gl: frame {n}: {:?}", counters);
     }
 }
 
+/// The smallest rectangle holding `a` and `b` (`[x, y, width, height]`).
+fn union(a: [i32; 4], b: [i32; 4]) -> [i32; 4] {
+    let (x0, y0) = (a[0].min(b[0]), a[1].min(b[1]));
+    let x1 = (a[0].saturating_add(a[2])).max(b[0].saturating_add(b[2]));
+    let y1 = (a[1].saturating_add(a[3])).max(b[1].saturating_add(b[3]));
+    [x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0)]
+}
+
+/// `r` without what lies left of or below the window's origin (GL reads
+/// and writes no pixel there) and at most 16384 pixels a side.
+fn clip_to_window([x, y, w, h]: [i32; 4]) -> [i32; 4] {
+    let (x0, y0) = (x.max(0), y.max(0));
+    let w = (x.saturating_add(w) - x0).min(16384);
+    let h = (y.saturating_add(h) - y0).min(16384);
+    [x0, y0, w, h]
+}
+
 /// `counters.txt` in `dir`: the recorder's counters, the instances left
-/// out of the last frame and each unsupported feature's count
+/// out of the last frame, its passes traced and kept as GL drew them
+/// (`passes.traced`, `passes.kept`) and each unsupported feature's count
 /// (`unsupported.NAME=count`).
 fn write_counters(
     dir: &std::path::Path,
     c: &crate::record::Counters,
     left_out: usize,
+    passes: &[(&str, usize)],
     unsupported: &[(&'static str, u64)],
 ) {
     let mut line = format!(
-        "frames={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_refits={} draw_inline={} instances={} triangles={} ignored={} left_out={left_out}",
+        "frames={} passes={} passes_merged={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_refits={} draw_inline={} instances={} triangles={} ignored={} left_out={left_out}",
         c.frames,
+        c.passes,
+        c.passes_merged,
         c.list_builds,
         c.list_reuses,
         c.list_inline,
@@ -136,6 +210,9 @@ fn write_counters(
         c.triangles,
         c.ignored
     );
+    for (what, count) in passes {
+        line += &format!(" passes.{what}={count}");
+    }
     for (what, count) in unsupported {
         line += &format!(" unsupported.{what}={count}");
     }
@@ -175,11 +252,12 @@ fn read_back(buffer: u32, [x, y, w, h]: [i32; 4]) -> Image {
     Image { width: w as u32, height: h as u32, rgba }
 }
 
-/// Writes `img` at window position `(x, y)` with `glDrawPixels`.
+/// Writes `img` at window position `(x, y)` with `glDrawPixels`; with
+/// `keep`, its pixels of alpha 0 leave GL's as they are (alpha test).
 ///
 /// # Safety
 /// A current GL context (the program's, at its swap).
-unsafe fn draw(img: &Image, x: i32, y: i32, _buffer: u32) {
+unsafe fn draw(img: &Image, x: i32, y: i32, keep: bool) {
     // SAFETY: plain state changes, pushed and popped in pairs; the pixel
     // pointer covers width·height RGBA pixels at unpack alignment 1.
     unsafe {
@@ -202,6 +280,10 @@ unsafe fn draw(img: &Image, x: i32, y: i32, _buffer: u32) {
             gl::CULL_FACE,
         ] {
             real::glDisable(cap);
+        }
+        if keep {
+            real::glEnable(gl::ALPHA_TEST);
+            real::glAlphaFunc(gl::GREATER, 0.5);
         }
         real::glPixelStorei(gl::UNPACK_ALIGNMENT, 1);
         real::glPixelStorei(gl::UNPACK_ROW_LENGTH, 0);

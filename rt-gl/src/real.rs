@@ -133,6 +133,8 @@ real_fns! {
     glPopMatrix();
     glLoadIdentity();
     glDisable(cap: u32);
+    glEnable(cap: u32);
+    glAlphaFunc(func: u32, reference: f32);
     glPixelStorei(pname: u32, param: i32);
     glPixelZoom(x: f32, y: f32);
     glWindowPos2i(x: i32, y: i32);

@@ -22,7 +22,7 @@ use rt_core::{
 };
 
 use crate::record::{
-    FrameDraws, Geometry, GeometryError, Lighting, Recorded, Shading, normal_matrix,
+    FrameDraws, Geometry, GeometryError, Lighting, Paint, Recorded, Shading, normal_matrix,
 };
 
 /// How frames are lit: GL's fixed-function model, or ray-traced.
@@ -190,6 +190,8 @@ pub struct FrameScene {
     instances: Instances<Arc<Recorded>>,
     /// Per instance: the normal matrix of its transform.
     normal: Vec<Mat3>,
+    /// Per instance: what its call paints it with.
+    paint: Vec<Option<Paint>>,
     diagonal: f32,
     left_out: usize,
 }
@@ -222,7 +224,9 @@ impl FrameScene {
                 && m.row(3) == glam::Vec4::W
         };
         let mut left_out = 0;
-        for (rec, m) in &frame.instances {
+        let mut paint = Vec::with_capacity(frame.instances.len());
+        for inst in &frame.instances {
+            let (rec, m) = (&inst.recorded, &inst.transform);
             if !placeable(m) {
                 left_out += 1;
                 continue;
@@ -236,12 +240,13 @@ impl FrameScene {
                 }
             };
             placements.push((k as u32, *m));
+            paint.push(inst.paint);
         }
         let normal = placements.iter().map(|(_, m)| normal_matrix(m)).collect();
         let instances = Instances::new(objects, &placements).map_err(RenderError::Instance)?;
         let b = Object::bounds(&scene).union(instances.bounds());
         let diagonal = if b.is_empty() { 0.0 } else { (b.max - b.min).length() };
-        Ok(Self { immediate: frame.immediate, scene, instances, normal, diagonal, left_out })
+        Ok(Self { immediate: frame.immediate, scene, instances, normal, paint, diagonal, left_out })
     }
 
     /// Instances left out of the trace: their transforms cannot place them
@@ -280,80 +285,173 @@ impl FrameScene {
         background: Vec4,
         opts: &Options,
     ) -> Result<Image, RenderError> {
-        if width == 0 || height == 0 || width > 16384 || height > 16384 {
-            return Err(RenderError::BadViewport);
-        }
+        self.render_with_depth(lighting, projection, width, height, background, opts)
+            .map(|(image, _)| image)
+    }
+
+    /// [`FrameScene::render`], and each pixel's window depth: GL's depth
+    /// of the closest hit in `[0, 1]` (the default depth range),
+    /// `f32::INFINITY` where nothing is hit. What passes are composited
+    /// by.
+    ///
+    /// # Errors
+    /// As [`FrameScene::render`].
+    pub fn render_with_depth(
+        &self,
+        lighting: &Lighting,
+        projection: Mat4,
+        width: u32,
+        height: u32,
+        background: Vec4,
+        opts: &Options,
+    ) -> Result<(Image, Vec<f32>), RenderError> {
         if !opts.is_valid() {
             return Err(RenderError::BadOptions);
+        }
+        let shade = Shade { lighting, opts, background };
+        let (rgba, depth) = self.trace(projection, width, height, Some(&shade))?;
+        Ok((Image { width, height, rgba }, depth))
+    }
+
+    /// Each pixel's window depth as [`FrameScene::render_with_depth`]
+    /// gives it, without shading: where a 2-D overlay's draws cover the
+    /// viewport, and how deep.
+    ///
+    /// # Errors
+    /// [`RenderError::BadProjection`] or [`RenderError::BadViewport`].
+    pub fn coverage(
+        &self,
+        projection: Mat4,
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<f32>, RenderError> {
+        self.trace(projection, width, height, None).map(|(_, depth)| depth)
+    }
+
+    /// One ray per pixel: colours (when `shade` is given; else empty) and
+    /// window depths.
+    fn trace(
+        &self,
+        projection: Mat4,
+        width: u32,
+        height: u32,
+        shade: Option<&Shade<'_>>,
+    ) -> Result<(Vec<u8>, Vec<f32>), RenderError> {
+        if width == 0 || height == 0 || width > 16384 || height > 16384 {
+            return Err(RenderError::BadViewport);
         }
         let inv = projection.inverse();
         if projection.determinant() == 0.0 || !inv.is_finite() {
             return Err(RenderError::BadProjection);
         }
-        let bg = to_rgba8(background);
-        let mut rgba = vec![0u8; 4 * width as usize * height as usize];
-        rgba.par_chunks_mut(4 * width as usize).enumerate().for_each(|(y, row)| {
-            for (x, px) in row.chunks_exact_mut(4).enumerate() {
-                let ndc = Vec2::new(
-                    2.0 * (x as f32 + 0.5) / width as f32 - 1.0,
-                    2.0 * (y as f32 + 0.5) / height as f32 - 1.0,
-                );
-                let near = inv.project_point3(ndc.extend(-1.0));
-                let far = inv.project_point3(ndc.extend(1.0));
-                // Parameter 0..1 spans the near to the far plane: GL's clipping.
-                let ray = Ray::with_range(near, far - near, 0.0, 1.0);
-                let c = match self.closest(&ray) {
+        let bg = shade.map(|s| to_rgba8(s.background));
+        let (w, n) = (width as usize, width as usize * height as usize);
+        let mut rgba = vec![0u8; if shade.is_some() { 4 * n } else { 0 }];
+        let mut depth = vec![f32::INFINITY; n];
+        let pixel = |x: usize, y: usize, px: Option<&mut [u8]>, z: &mut f32| {
+            let ndc = Vec2::new(
+                2.0 * (x as f32 + 0.5) / width as f32 - 1.0,
+                2.0 * (y as f32 + 0.5) / height as f32 - 1.0,
+            );
+            let near = inv.project_point3(ndc.extend(-1.0));
+            let far = inv.project_point3(ndc.extend(1.0));
+            // Parameter 0..1 spans the near to the far plane: GL's clipping.
+            let ray = Ray::with_range(near, far - near, 0.0, 1.0);
+            let hit = self.closest(&ray);
+            if let Some((_, h)) = &hit {
+                let ndc_z = projection.project_point3(h.position).z;
+                *z = if ndc_z.is_finite() { (0.5 * ndc_z + 0.5).clamp(0.0, 1.0) } else { 0.0 };
+            }
+            if let (Some(px), Some(s), Some(bg)) = (px, shade, bg) {
+                let c = match hit {
                     Some((src, hit)) => {
                         let seed = (y as u64) << 32 | x as u64;
-                        let ctx = ShadeCtx { lighting, opts, background, seed };
+                        let ctx = ShadeCtx {
+                            lighting: s.lighting,
+                            opts: s.opts,
+                            background: s.background,
+                            seed,
+                        };
                         to_rgba8(self.shade(&ray, src, &hit, &ctx, 0))
                     }
                     None => bg,
                 };
                 px.copy_from_slice(&c);
             }
-        });
-        Ok(Image { width, height, rgba })
+        };
+        if shade.is_some() {
+            rgba.par_chunks_mut(4 * w).zip(depth.par_chunks_mut(w)).enumerate().for_each(
+                |(y, (row, zs))| {
+                    for (x, (px, z)) in row.chunks_exact_mut(4).zip(zs).enumerate() {
+                        pixel(x, y, Some(px), z);
+                    }
+                },
+            );
+        } else {
+            depth.par_chunks_mut(w).enumerate().for_each(|(y, zs)| {
+                for (x, z) in zs.iter_mut().enumerate() {
+                    pixel(x, y, None, z);
+                }
+            });
+        }
+        Ok((rgba, depth))
     }
 
-    /// The shading, colour and normal (eye space) at a hit.
-    fn surface(&self, src: Source, hit: &Hit) -> (Shading, Vec4, Vec3) {
-        let (g, nm) = match src {
-            Source::Immediate => (&self.immediate, Mat3::IDENTITY),
+    /// The shading, colour, normal (eye space) and normal length (GL's,
+    /// interpolated as Gouraud shading interpolates what it lights with)
+    /// at a hit.
+    fn surface(&self, src: Source, hit: &Hit) -> (Shading, Vec4, Vec3, f32) {
+        let (g, nm, paint) = match src {
+            Source::Immediate => (&self.immediate, Mat3::IDENTITY, None),
             Source::Instance(i) => {
                 // `i` came from this frame's own instances.
                 let obj = self.instances.object_of(i).unwrap_or(0);
-                (self.instances.objects()[obj as usize].geometry(), self.normal[i as usize])
+                let g = self.instances.objects()[obj as usize].geometry();
+                (g, self.normal[i as usize], self.paint[i as usize].as_ref())
             }
         };
-        let (sh, col, n) = Self::surface_in(g, hit);
-        // Spheres and tubes already give the world normal.
-        let n = if hit.kind == PrimKind::Triangle { nm * n } else { n };
-        (sh, col, n)
+        Self::surface_in(g, hit, nm, paint)
     }
 
     /// Indexes freely: every geometry of the frame passed
     /// [`Geometry::check`] when its BVHs were built, and a hit's `prim`
     /// comes from those BVHs.
-    fn surface_in(g: &Geometry, hit: &Hit) -> (Shading, Vec4, Vec3) {
+    /// `nm` takes the geometry's normals to eye space (spheres and tubes
+    /// give theirs there already).
+    /// `paint`: the instance's call's shading and colour, where they
+    /// replace the recording's.
+    fn surface_in(
+        g: &Geometry,
+        hit: &Hit,
+        nm: Mat3,
+        paint: Option<&Paint>,
+    ) -> (Shading, Vec4, Vec3, f32) {
         let p = hit.prim as usize;
+        let color = |v: usize| match paint {
+            Some(p) if v < p.vertices as usize => p.color,
+            _ => g.colors[v],
+        };
+        let shading = |s: u32| paint.map_or(g.shadings[s as usize], |p| p.shading);
         match hit.kind {
             PrimKind::Triangle => {
                 let [a, b, c] = g.triangles[p].map(|i| i as usize);
                 let (s, pv) = g.triangle_info[p];
-                let sh = g.shadings[s as usize];
+                let sh = shading(s);
                 if sh.flat {
-                    (sh, g.colors[pv as usize], g.normals[pv as usize])
+                    let n = nm * g.normals[pv as usize];
+                    (sh, color(pv as usize), n, n.length())
                 } else {
                     let w = Vec3::new(1.0 - hit.uv.x - hit.uv.y, hit.uv.x, hit.uv.y);
-                    let col = w.x * g.colors[a] + w.y * g.colors[b] + w.z * g.colors[c];
-                    let n = w.x * g.normals[a] + w.y * g.normals[b] + w.z * g.normals[c];
-                    (sh, col, n)
+                    let col = w.x * color(a) + w.y * color(b) + w.z * color(c);
+                    let [na, nb, nc] = [a, b, c].map(|v| nm * g.normals[v]);
+                    let n = w.x * na + w.y * nb + w.z * nc;
+                    let len = w.x * na.length() + w.y * nb.length() + w.z * nc.length();
+                    (sh, col, n, len)
                 }
             }
             PrimKind::Sphere => {
                 let (v, _, s) = g.spheres[p];
-                (g.shadings[s as usize], g.colors[v as usize], hit.normal)
+                (shading(s), color(v as usize), hit.normal, 1.0)
             }
             PrimKind::Capsule => {
                 let ([a, b], _, s) = g.tubes[p];
@@ -364,8 +462,8 @@ impl FrameScene {
                 } else {
                     ((hit.position - pa).dot(d) / d.length_squared()).clamp(0.0, 1.0)
                 };
-                let col = g.colors[a as usize].lerp(g.colors[b as usize], f);
-                (g.shadings[s as usize], col, hit.normal)
+                let col = color(a as usize).lerp(color(b as usize), f);
+                (shading(s), col, hit.normal, 1.0)
             }
         }
     }
@@ -373,13 +471,16 @@ impl FrameScene {
     /// GL's lighting equation at `hit`, per pixel.
     fn shade(&self, ray: &Ray, src: Source, hit: &Hit, ctx: &ShadeCtx<'_>, depth: u32) -> Vec4 {
         let ShadeCtx { lighting, opts, seed, .. } = *ctx;
-        let (sh, color, normal) = self.surface(src, hit);
+        let (sh, color, normal, length) = self.surface(src, hit);
         if !sh.lit {
             return color;
         }
         // Spheres and tubes carry their own normal; triangles the one
-        // the program gave (GL_NORMALIZE or not, lighting wants it unit).
+        // the program gave, whose length GL keeps in the lighting dot
+        // products unless GL_NORMALIZE is on (`gain`).
         let mut n = normal.normalize_or_zero();
+        let gain =
+            if n == Vec3::ZERO || sh.normalize || !length.is_finite() { 1.0 } else { length };
         if n == Vec3::ZERO {
             n = hit.normal;
         }
@@ -428,7 +529,7 @@ impl FrameScene {
                 continue;
             }
             c += k * l.ambient * m.ambient * ambient_visibility;
-            let ndl = n.dot(to_light);
+            let ndl = gain * n.dot(to_light);
             if ndl <= 0.0 {
                 continue;
             }
@@ -443,7 +544,7 @@ impl FrameScene {
             }
             c += k * ndl * l.diffuse * m.diffuse;
             let h = (to_light + eye).normalize_or_zero();
-            let ndh = n.dot(h).max(0.0);
+            let ndh = (gain * n.dot(h)).max(0.0);
             let spec = if m.shininess == 0.0 { 1.0 } else { ndh.powf(m.shininess) };
             c += k * spec * l.specular * m.specular;
         }
@@ -482,6 +583,13 @@ impl FrameScene {
     }
 }
 
+/// What shading a trace needs besides the scene.
+struct Shade<'a> {
+    lighting: &'a Lighting,
+    opts: &'a Options,
+    background: Vec4,
+}
+
 /// What every shading call of one frame shares.
 #[derive(Clone, Copy)]
 struct ShadeCtx<'a> {
@@ -492,6 +600,6 @@ struct ShadeCtx<'a> {
     seed: u64,
 }
 
-fn to_rgba8(c: Vec4) -> [u8; 4] {
+pub(crate) fn to_rgba8(c: Vec4) -> [u8; 4] {
     c.to_array().map(|x| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)
 }

@@ -100,11 +100,11 @@ fn step() -> impl Strategy<Value = Step> {
 }
 
 fn trace(r: &Recorder, mode: Illumination) {
-    let frame = r.frame().clone();
+    let frame = r.frame().clone().draws();
     // What the recorder makes is always well formed.
     assert_eq!(frame.immediate.check(), Ok(()));
-    for (rec, _) in &frame.instances {
-        assert_eq!(rec.geometry().check(), Ok(()));
+    for inst in &frame.instances {
+        assert_eq!(inst.recorded.geometry().check(), Ok(()));
     }
     // Building may refuse non-finite geometry; rendering may refuse the
     // view: both are errors, not panics.
@@ -171,6 +171,6 @@ proptest! {
             r.command(Command::Vertex(v.extend(1.0)));
         }
         r.command(Command::End);
-        prop_assert_eq!(r.frame().immediate.triangles.len(), 1);
+        prop_assert_eq!(r.frame().clone().draws().immediate.triangles.len(), 1);
     }
 }

@@ -14,8 +14,8 @@ use rt_accel::BuildError;
 use rt_core::glam::{Mat4, Vec3, Vec4};
 use rt_gl::{
     record::{
-        Command, FrameDraws, Geometry, GeometryError, Lighting, MaterialState, Primitive, Recorded,
-        Recorder, Shading, frustum, translate,
+        Command, FrameDraws, Geometry, GeometryError, Instance, Lighting, MaterialState, Primitive,
+        Recorded, Recorder, Shading, frustum, translate,
     },
     render::{FrameScene, Illumination, Image, MAX_AO_SAMPLES, MAX_BOUNCES, Options, RenderError},
 };
@@ -31,7 +31,13 @@ fn projection() -> Mat4 {
 
 /// Unlit: the image shows the vertex colours as they are.
 fn unlit() -> Shading {
-    Shading { lit: false, flat: false, material: MaterialState::default(), color_material: None }
+    Shading {
+        lit: false,
+        flat: false,
+        material: MaterialState::default(),
+        color_material: None,
+        normalize: false,
+    }
 }
 
 /// A red triangle at z = −3, a green sphere and a blue tube in front of
@@ -78,8 +84,12 @@ fn instanced(g: Geometry) -> FrameDraws {
     FrameDraws {
         immediate: Geometry::default(),
         instances: vec![
-            (Arc::clone(&rec), Mat4::IDENTITY),
-            (rec, translate(Vec3::new(0.0, 0.0, -4.0))),
+            Instance { recorded: Arc::clone(&rec), transform: Mat4::IDENTITY, paint: None },
+            Instance {
+                recorded: rec,
+                transform: translate(Vec3::new(0.0, 0.0, -4.0)),
+                paint: None,
+            },
         ],
         lighting: None,
     }
@@ -245,6 +255,7 @@ fn hall_of_mirrors() -> Geometry {
         flat: false,
         material: MaterialState { specular: Vec4::ONE, ..MaterialState::default() },
         color_material: None,
+        normalize: false,
     };
     let mut g = Geometry { shadings: vec![mirror], ..Geometry::default() };
     for (z, n) in [(-3.0, Vec3::Z), (1.0, Vec3::NEG_Z)] {

@@ -79,7 +79,7 @@ fn primitives_assemble_into_consistently_oriented_triangles() {
         let mut r = Recorder::new();
         r.command(Command::MultMatrix(translate(Vec3::new(0.0, 0.0, -5.0))));
         draw(&mut r, mode, &verts);
-        let g = r.end_frame().immediate;
+        let g = r.end_frame().draws().immediate;
         assert_eq!(g.triangles.len(), expected, "mode {mode:#x}");
         for t in &g.triangles {
             let [a, b, c] = t.map(|i| g.positions[i as usize]);
@@ -106,7 +106,7 @@ fn points_and_lines_get_their_pixel_size_at_their_depth() {
     draw(&mut r, gl::POINTS, &[Vec3::new(0.0, 0.0, -2.0), Vec3::new(0.0, 0.0, -4.0)]);
     r.command(Command::LineWidth(4.0));
     draw(&mut r, gl::LINE_LOOP, &ring(3).iter().map(|v| *v - 3.0 * Vec3::Z).collect::<Vec<_>>());
-    let g = r.end_frame().immediate;
+    let g = r.end_frame().draws().immediate;
     // At depth 2 the 200-pixel view is 4 units tall: 10 px = 0.2 units.
     assert!((g.spheres[0].1 - 0.1).abs() < 1e-6, "{:?}", g.spheres);
     assert!((g.spheres[1].1 - 0.2).abs() < 1e-6);
@@ -150,7 +150,7 @@ fn lists_are_recorded_once_and_instanced() {
             r.command(Command::CallList(1 + k as u32));
             r.command(Command::PopMatrix);
         }
-        let f = r.end_frame();
+        let f = r.end_frame().draws();
         assert_eq!(f.instances.len(), 2, "frame {frame}");
         assert!(f.immediate.is_empty());
         if frame == 0 {
@@ -173,7 +173,7 @@ fn lists_are_recorded_once_and_instanced() {
                 direct.command(Command::Normal(Vec3::X));
                 draw(&mut direct, gl::TRIANGLES, &[Vec3::ZERO, Vec3::Y, Vec3::Z]);
             }
-            let want = direct.end_frame().immediate;
+            let want = direct.end_frame().draws().immediate;
             let got = f.flatten().expect("recorded geometry is well formed");
             assert_eq!(got.triangles, want.triangles);
             for (a, b) in got.positions.iter().zip(&want.positions) {
@@ -196,6 +196,80 @@ fn lists_are_recorded_once_and_instanced() {
     assert_eq!(r.counters.list_builds, 3);
 }
 
+/// A list that sets no shading state of its own, called many times a
+/// frame after a different colour (colour material) or material each
+/// time, is recorded once; each instance is painted with its call's
+/// colour and material, and the frame traces exactly as the same calls
+/// executed in immediate mode do. Vertices after the list's own
+/// `glColor` keep that colour.
+#[test]
+fn a_list_called_with_many_colours_is_recorded_once() {
+    let tri = [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+    let own = Vec4::new(0.1, 0.9, 0.2, 1.0);
+    // The list's body: a triangle in the caller's colour, then one in
+    // its own, both facing the eye.
+    let body = |r: &mut Recorder, dx: f32| {
+        r.command(Command::Normal(Vec3::Z));
+        draw(r, gl::TRIANGLES, &tri.map(|v| v * 0.2 + Vec3::X * dx));
+        r.command(Command::Color(own));
+        draw(r, gl::TRIANGLES, &tri.map(|v| v * 0.1 + Vec3::new(dx, 0.4, 0.0)));
+    };
+    // Calls: (colour-material colour) or (material diffuse), each placed
+    // apart along x.
+    let calls: Vec<(bool, Vec4)> = (0..24)
+        .map(|i| {
+            let t = i as f32 / 24.0;
+            (i % 2 == 0, Vec4::new(t, 1.0 - t, 0.5 * t, 1.0))
+        })
+        .collect();
+    let run = |r: &mut Recorder, listed: bool| {
+        r.command(Command::MatrixMode(gl::PROJECTION));
+        r.command(Command::LoadMatrix(ortho(-1.0, 1.0, -1.0, 1.0, -1.0, 1.0).unwrap()));
+        r.command(Command::MatrixMode(gl::MODELVIEW));
+        r.command(Command::Enable(gl::LIGHTING));
+        r.command(Command::Enable(gl::LIGHT0));
+        for (k, (color_material, c)) in calls.iter().enumerate() {
+            let dx = -0.9 + 1.8 * k as f32 / calls.len() as f32;
+            if *color_material {
+                r.command(Command::Enable(gl::COLOR_MATERIAL));
+                r.command(Command::Color(*c));
+            } else {
+                r.command(Command::Disable(gl::COLOR_MATERIAL));
+                r.command(Command::Material(gl::FRONT, gl::DIFFUSE, *c));
+                r.command(Command::Color(Vec4::new(0.5, 0.5, 0.5, 1.0)));
+            }
+            if listed {
+                r.command(Command::LoadMatrix(translate(Vec3::X * dx)));
+                r.command(Command::CallList(7));
+            } else {
+                r.command(Command::LoadIdentity);
+                body(r, dx);
+            }
+        }
+    };
+    let mut listed = Recorder::new();
+    listed.new_list(7, gl::COMPILE);
+    body(&mut listed, 0.0);
+    listed.end_list();
+    run(&mut listed, true);
+    assert_eq!(
+        (listed.counters.list_builds, listed.counters.list_reuses),
+        (1, calls.len() as u64 - 1)
+    );
+    let mut direct = Recorder::new();
+    run(&mut direct, false);
+    let image = |r: &mut Recorder| {
+        let (lighting, projection) = (r.lighting.clone(), r.projection());
+        let scene = FrameScene::build(r.end_frame().draws()).expect("finite");
+        scene.render(&lighting, projection, 96, 32, Vec4::ZERO, &Options::default()).unwrap()
+    };
+    let (a, b) = (image(&mut listed), image(&mut direct));
+    let worst = a.rgba.iter().zip(&b.rgba).map(|(x, y)| x.abs_diff(*y)).max();
+    assert!(worst <= Some(1), "painted instances differ from immediate mode by {worst:?}/255");
+    // Both colours of every call are there.
+    assert!(a.rgba.chunks_exact(4).any(|p| p[1] > 200 && p[0] < 60), "the list's own colour");
+}
+
 /// A draw from buffer objects is recorded once and reused while the
 /// buffers keep their contents; `glBufferSubData` records it again.
 #[test]
@@ -213,7 +287,7 @@ fn buffer_draws_are_cached_until_the_buffer_changes() {
         r.draw_arrays(gl::TRIANGLES, 0, 3);
     }
     assert_eq!((r.counters.draw_builds, r.counters.draw_reuses), (1, 1));
-    let f = r.end_frame();
+    let f = r.end_frame().draws();
     assert_eq!(f.instances.len(), 2);
     assert_eq!(
         f.flatten().expect("recorded geometry is well formed").positions[2],
@@ -263,7 +337,7 @@ fn pixels_follow_the_fixed_function_lighting_equation() {
         &[Vec3::new(-4.0, -4.0, -3.0), Vec3::new(4.0, -4.0, -3.0), Vec3::new(0.0, 4.0, -3.0)],
     );
     let frame = r.end_frame();
-    let scene = FrameScene::build(frame).expect("finite");
+    let scene = FrameScene::build(frame.draws()).expect("finite");
     let img = scene
         .render(
             &r.lighting,
@@ -290,7 +364,7 @@ fn pixels_follow_the_fixed_function_lighting_equation() {
         gl::TRIANGLES,
         &[Vec3::new(-4.0, -4.0, -3.0), Vec3::new(4.0, -4.0, -3.0), Vec3::new(0.0, 4.0, -3.0)],
     );
-    let scene = FrameScene::build(r.end_frame()).unwrap();
+    let scene = FrameScene::build(r.end_frame().draws()).unwrap();
     let img =
         scene.render(&r.lighting, r.projection(), 32, 32, Vec4::ZERO, &Options::default()).unwrap();
     assert_eq!(img.get(16, 16), Some([51, 102, 153, 255]));
@@ -315,7 +389,7 @@ fn rt_mode_adds_shadows_deterministically() {
     };
     draw(&mut r, gl::QUADS, &square(2.0, -1.0));
     draw(&mut r, gl::QUADS, &square(0.3, 1.0));
-    let scene = FrameScene::build(r.end_frame()).unwrap();
+    let scene = FrameScene::build(r.end_frame().draws()).unwrap();
     let render = |mode, threads: usize| {
         let opts = Options { mode, ao_samples: 4, ..Options::default() };
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
@@ -354,7 +428,7 @@ fn bad_views_and_vertices_are_refused() {
     r.command(Command::End);
     let f = r.end_frame();
     assert!(f.is_empty());
-    let scene = FrameScene::build(f).unwrap();
+    let scene = FrameScene::build(f.draws()).unwrap();
     let l = r.lighting.clone();
     let o = Options::default();
     assert_eq!(scene.render(&l, Mat4::ZERO, 8, 8, Vec4::ZERO, &o), Err(RenderError::BadProjection));
@@ -420,7 +494,7 @@ fn rt_mode_mirrors_specular_surfaces() {
         Vec3::new(-3.0, 3.0, -1.0),
     ];
     draw(&mut r, gl::QUADS, &floor);
-    let scene = FrameScene::build(r.end_frame()).unwrap();
+    let scene = FrameScene::build(r.end_frame().draws()).unwrap();
     let sky = Vec4::new(0.0, 0.0, 1.0, 1.0);
     let render = |mode| {
         let opts = Options { mode, ao_samples: 0, shadows: false, ..Options::default() };

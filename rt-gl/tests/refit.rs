@@ -75,9 +75,9 @@ fn recorder(positions: &[f32], indices: &[u32]) -> Recorder {
 fn draw_elements(r: &mut Recorder, count: usize) -> Arc<Recorded> {
     // SAFETY: the arrays and indices live in buffer objects (bounds-checked).
     unsafe { r.draw_elements(gl::TRIANGLES, count as i32, gl::UNSIGNED_INT, 0) };
-    let frame = r.end_frame();
+    let frame = r.end_frame().draws();
     assert_eq!(frame.instances.len(), 1);
-    Arc::clone(&frame.instances[0].0)
+    Arc::clone(&frame.instances[0].recorded)
 }
 
 /// Replaces the positions in `VBO`.
@@ -212,7 +212,7 @@ fn changed_triangles_are_built_not_refit() {
     // Another primitive type over the same buffers.
     // SAFETY: buffer data only, bounds-checked.
     unsafe { r.draw_elements(gl::TRIANGLE_STRIP, flipped.len() as i32, gl::UNSIGNED_INT, 0) };
-    let rec = Arc::clone(&r.end_frame().instances[0].0);
+    let rec = Arc::clone(&r.end_frame().draws().instances[0].recorded);
     check(&r, &rec, &mut builds, 1);
 
     // The full draw again (its vertices moved since it was traced: a

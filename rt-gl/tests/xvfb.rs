@@ -287,7 +287,8 @@ fn glxgears_is_traced_with_its_lists_built_once() {
 #[test]
 #[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
 fn a_privately_loaded_gl_is_found_and_traced() {
-    private_gl_frames_match_the_raster("private", &[]);
+    let c = private_gl_frames_match_the_raster("private", &[]);
+    assert_eq!((c["passes.traced"], c["passes.kept"]), (1, 0), "{c:?}");
 }
 
 /// A program that never calls `glViewport` draws in GL's initial
@@ -329,9 +330,45 @@ fn lights_turned_off_before_the_swap_still_light_the_frame() {
     private_gl_frames_match_the_raster("lightsoff", &["lightsoff"]);
 }
 
+/// A mesh generator's frame: a band behind everything under the identity
+/// projection (depth test off), the ball under a 3-D `glOrtho`, then a
+/// bar and a frame of lines under a pixel `glOrtho`. rt-gl traced all of
+/// it through the projection at the swap (the pixel one) and lost the
+/// ball; now the 3-D pass is traced, the band and the overlays are kept
+/// as Mesa drew them, and every frame agrees with Mesa.
+#[test]
+#[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
+fn a_3d_pass_is_traced_under_its_own_projection_and_overlays_kept() {
+    let c = private_gl_frames_match_the_raster("overlay", &["overlay"]);
+    assert_eq!((c["passes.traced"], c["passes.kept"]), (1, 2), "{c:?}");
+}
+
+/// Two views side by side, each with its own viewport, scissored clear
+/// and projection (perspective, orthographic): each is traced into its
+/// own rectangle and agrees with Mesa.
+#[test]
+#[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
+fn two_viewports_are_traced_each_in_its_own_rectangle() {
+    let c = private_gl_frames_match_the_raster("viewports", &["viewports"]);
+    assert_eq!((c["passes.traced"], c["passes.kept"]), (2, 0), "{c:?}");
+}
+
+/// A ball drawn after `glClear(GL_DEPTH_BUFFER_BIT)`, behind an earlier
+/// one: GL shows it in front, and so does the trace (one scene would
+/// hide it behind the first).
+#[test]
+#[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
+fn a_depth_clear_draws_the_next_pass_over_the_frame() {
+    let c = private_gl_frames_match_the_raster("depthclear", &["depthclear"]);
+    assert_eq!((c["passes.traced"], c["passes.kept"]), (2, 0), "{c:?}");
+}
+
 /// Runs the private-GL program with `args` after the frame count; every
-/// frame traced, each agreeing with Mesa's raster.
-fn private_gl_frames_match_the_raster(name: &str, args: &[&str]) {
+/// frame traced, each agreeing with Mesa's raster. Returns the counters.
+fn private_gl_frames_match_the_raster(
+    name: &str,
+    args: &[&str],
+) -> std::collections::HashMap<String, u64> {
     let dir = scratch(name);
     let exe = program(&dir, "private_gl", &["-lX11", "-ldl", "-lm"]);
     let frames = 6;
@@ -339,8 +376,10 @@ fn private_gl_frames_match_the_raster(name: &str, args: &[&str]) {
     assert!(stdout.contains(&format!("frames {frames}")), "{stdout}");
     assert!(!stderr.contains("is not in the system's GL"), "{stderr}");
     frames_match_the_raster(&dir, frames);
-    assert_eq!(counters(&dir)["frames"], frames as u64);
+    let c = counters(&dir);
+    assert_eq!(c["frames"], frames as u64);
     let _ = std::fs::remove_dir_all(&dir);
+    c
 }
 
 /// A ball drawn from a display list and again as its planar shadow, the

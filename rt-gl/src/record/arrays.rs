@@ -507,7 +507,7 @@ impl Recorder {
             if let Some((_, g)) = self.draw_cache.get(&key).filter(|(k, _)| *k == inherited) {
                 let g = Arc::clone(g);
                 self.counters.draw_reuses += 1;
-                self.instance(g, mv);
+                self.instance(g, mv, None);
                 return;
             }
             // SAFETY: passed on from the caller.
@@ -538,7 +538,7 @@ impl Recorder {
                 self.draw_cache.remove(&old);
             }
             self.draw_cache.insert(key, (inherited, Arc::clone(&g)));
-            self.instance(g, mv);
+            self.instance(g, mv, None);
         } else {
             if self.compiling.is_none() {
                 self.counters.draw_inline += 1;

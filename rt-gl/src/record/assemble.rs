@@ -46,15 +46,13 @@ impl Recorder {
             }
             _ => Vec::new(),
         };
-        if shading.lit && self.capture.is_none() && self.state_only == 0 {
-            self.frame.lighting = Some(self.lighting.clone());
-        }
         // Clockwise front faces: each triangle reversed, so its geometric
         // normal points where GL's front does.
         let cw = self.front_cw;
-        let (g, to_local, n_to_local) = match &mut self.capture {
-            Some(c) => (&mut c.geometry, c.to_local, c.normal_to_local),
-            None => (&mut self.frame.immediate, Mat4::IDENTITY, Mat3::IDENTITY),
+        let (g, to_local, n_to_local) = if let Some(c) = &mut self.capture {
+            (&mut c.geometry, c.to_local, c.normal_to_local)
+        } else {
+            (&mut self.draws(shading.lit).immediate, Mat4::IDENTITY, Mat3::IDENTITY)
         };
         let base = g.positions.len() as u32;
         for &(p, n, c) in verts {

@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
-use super::{Geometry, Recorded, Recorder, Shading};
+use super::{Geometry, Instance, Paint, Recorded, Recorder, Shading};
 
 /// The inherited state a cached list's geometry depends on.
 #[derive(Clone, Debug, PartialEq)]
@@ -25,6 +25,8 @@ pub(super) struct Capture {
     pub(super) to_local: Mat4,
     /// Eye-space normals to entry space.
     pub(super) normal_to_local: Mat3,
+    /// Vertices recorded before the first `glColor` of the capture.
+    pub(super) color_from: Option<usize>,
 }
 
 impl Recorder {
@@ -47,8 +49,9 @@ impl Recorder {
         mv: Mat4,
         to_local: Mat4,
         f: impl FnOnce(&mut Self),
-    ) -> Arc<Recorded> {
-        Arc::new(Recorded::new(self.capture_geometry(mv, to_local, f)))
+    ) -> (Arc<Recorded>, u32) {
+        let (g, inherit) = self.capture_painted(mv, to_local, f);
+        (Arc::new(Recorded::new(g)), inherit)
     }
 
     /// The geometry `f` draws, in the entry space of the modelview `mv`
@@ -59,22 +62,44 @@ impl Recorder {
         to_local: Mat4,
         f: impl FnOnce(&mut Self),
     ) -> Geometry {
+        self.capture_painted(mv, to_local, f).0
+    }
+
+    /// [`Recorder::capture_geometry`] and how many of its first vertices
+    /// took the caller's colour.
+    fn capture_painted(
+        &mut self,
+        mv: Mat4,
+        to_local: Mat4,
+        f: impl FnOnce(&mut Self),
+    ) -> (Geometry, u32) {
         self.capture = Some(Capture {
             geometry: Geometry::default(),
             to_local,
             normal_to_local: Mat3::from_mat4(mv).transpose(),
+            color_from: None,
         });
         f(self);
-        self.capture.take().map(|c| c.geometry).unwrap_or_default()
+        let (g, from) = self.capture.take().map(|c| (c.geometry, c.color_from)).unwrap_or_default();
+        let inherit = from.unwrap_or(g.positions.len());
+        (g, u32::try_from(inherit).unwrap_or(u32::MAX))
+    }
+
+    /// The paint of a call made now whose recording's first `vertices`
+    /// take the caller's colour.
+    pub(super) fn paint(&self, vertices: u32) -> Paint {
+        Paint { shading: self.shading(), color: self.color, vertices }
     }
 
     /// Adds an instance of cached geometry to the frame.
-    pub(super) fn instance(&mut self, geometry: Arc<Recorded>, mv: Mat4) {
-        if !geometry.geometry().is_empty() && self.state_only == 0 {
-            if geometry.geometry().shadings.iter().any(|s| s.lit) {
-                self.frame.lighting = Some(self.lighting.clone());
-            }
-            self.frame.instances.push((geometry, mv));
+    pub(super) fn instance(&mut self, recorded: Arc<Recorded>, mv: Mat4, paint: Option<Paint>) {
+        if !recorded.geometry().is_empty() && self.state_only == 0 {
+            let lit = match &paint {
+                Some(p) => p.shading.lit,
+                None => recorded.geometry().shadings.iter().any(|s| s.lit),
+            };
+            let inst = Instance { recorded, transform: mv, paint };
+            self.draws(lit).instances.push(inst);
         }
     }
 

@@ -27,6 +27,11 @@ pub struct Counters {
     /// Array draws from client memory (or with points and lines),
     /// recorded as immediate geometry.
     pub draw_inline: u64,
+    /// Passes in the last frame ended (see [`Frame`](super::Frame)).
+    pub passes: u64,
+    /// Draws that joined the last pass of a frame because it already had
+    /// [`MAX_PASSES`](super::MAX_PASSES).
+    pub passes_merged: u64,
     /// Instances in the last frame ended.
     pub instances: u64,
     /// Triangles in the last frame ended (immediate and instanced).

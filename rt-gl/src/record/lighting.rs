@@ -94,8 +94,9 @@ impl Default for Lighting {
     }
 }
 
-/// How a primitive is shaded, besides its vertices' colours and normals.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// How a primitive is shaded, besides its vertices' colours and normals
+/// (default: GL's initial state, unlit).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Shading {
     /// `GL_LIGHTING` was on: the lighting equation; off: the colour.
     pub lit: bool,
@@ -106,6 +107,11 @@ pub struct Shading {
     /// `GL_COLOR_MATERIAL` on: the parameter (`GL_AMBIENT_AND_DIFFUSE`, …)
     /// the vertex colour stands for.
     pub color_material: Option<u32>,
+    /// `GL_NORMALIZE` or `GL_RESCALE_NORMAL` was on: normals are made
+    /// unit before lighting. Off, GL lights with the normal as the
+    /// modelview left it, so a scaled object lights brighter or darker,
+    /// and so does the trace.
+    pub normalize: bool,
 }
 
 impl Shading {

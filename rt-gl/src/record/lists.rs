@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use glam::{Vec3, Vec4};
 
-use super::{Command, Recorder, capture::Inherited};
+use super::{Command, Paint, Recorder, Shading, capture::Inherited};
 use crate::gl;
 
 /// Commands one top-level display-list call may execute (see
@@ -25,6 +25,12 @@ pub(super) struct List {
     cacheable: bool,
     /// Calls other lists: cached entries also depend on their definitions.
     nested: bool,
+    /// Sets no shading state (materials, lighting and colour-material
+    /// switches, shade model, normalization) and calls no list: every
+    /// primitive takes the caller's shading, and the vertices before its
+    /// first `glColor` the caller's colour, so one recording serves every
+    /// calling colour and material, each call painting its instance.
+    paintable: bool,
     /// What the list sets before its first vertex (so does not inherit).
     overrides: Overrides,
 }
@@ -151,10 +157,28 @@ impl Recorder {
             )
         });
         let nested = commands.iter().any(|c| matches!(c, Command::CallList(_)));
+        let paintable = !commands.iter().any(|c| {
+            matches!(
+                c,
+                Command::CallList(_)
+                    | Command::Material(..)
+                    | Command::ColorMaterial(..)
+                    | Command::ShadeModel(_)
+                    | Command::Enable(
+                        gl::LIGHTING | gl::COLOR_MATERIAL | gl::NORMALIZE | gl::RESCALE_NORMAL
+                    )
+                    | Command::Disable(
+                        gl::LIGHTING | gl::COLOR_MATERIAL | gl::NORMALIZE | gl::RESCALE_NORMAL
+                    )
+            )
+        });
         let overrides = Overrides::of(&commands);
         self.generation += 1;
         self.cache.remove(&id);
-        self.lists.insert(id, List { commands: commands.into(), cacheable, nested, overrides });
+        self.lists.insert(
+            id,
+            List { commands: commands.into(), cacheable, nested, paintable, overrides },
+        );
     }
 
     /// `glListBase(base)`.
@@ -206,31 +230,38 @@ impl Recorder {
         let plain = self.state_only == 0 && self.capture.is_none() && self.begin.is_none();
         match Self::to_local(&mv) {
             Some(to_local) if plain && list.cacheable => {
-                let key = list.overrides.mask(self.inherited(if list.nested {
+                let mut key = list.overrides.mask(self.inherited(if list.nested {
                     self.generation
                 } else {
                     0
                 }));
-                let hit = self.cache.get(&id).and_then(|v| v.iter().find(|(k, _)| *k == key));
-                let geometry = if let Some((_, g)) = hit {
-                    let g = Arc::clone(g);
+                if list.paintable {
+                    // Painted per call: neither is part of the recording.
+                    key.color = Vec4::ZERO;
+                    key.shading = Shading::default();
+                }
+                let paint = |r: &Self, vertices| list.paintable.then(|| r.paint(vertices));
+                let hit = self.cache.get(&id).and_then(|v| v.iter().find(|(k, ..)| *k == key));
+                let (geometry, paint) = if let Some((_, g, inherit)) = hit {
+                    let (g, paint) = (Arc::clone(g), paint(self, *inherit));
                     self.counters.list_reuses += 1;
                     // Replay for the state the list leaves behind.
                     self.state_only += 1;
                     self.run(&list.commands);
                     self.state_only -= 1;
-                    g
+                    (g, paint)
                 } else {
-                    let g = self.captured(mv, to_local, |r| r.run(&list.commands));
+                    let before = paint(self, 0);
+                    let (g, inherit) = self.captured(mv, to_local, |r| r.run(&list.commands));
                     let variants = self.cache.entry(id).or_default();
                     if variants.len() >= VARIANTS_PER_LIST {
                         variants.remove(0);
                     }
-                    variants.push((key, Arc::clone(&g)));
+                    variants.push((key, Arc::clone(&g), inherit));
                     self.counters.list_builds += 1;
-                    g
+                    (g, before.map(|p| Paint { vertices: inherit, ..p }))
                 };
-                self.instance(geometry, mv);
+                self.instance(geometry, mv, paint);
             }
             _ => {
                 if plain {

@@ -27,7 +27,8 @@
 //! - [`arrays`]: vertex arrays and buffer objects.
 //! - `geometry.rs`: [`Geometry`] and its BVHs; `check.rs`: its checks.
 //! - `recorded.rs`: [`Recorded`], cached geometry and its BVHs.
-//! - `frame.rs`: [`FrameDraws`]; `counters.rs`: [`Counters`].
+//! - `frame.rs`: [`Frame`], its [`Pass`]es and their [`FrameDraws`];
+//!   `counters.rs`: [`Counters`].
 //! - `matrix.rs`: the matrices of GL's matrix calls.
 
 pub mod arrays;
@@ -48,7 +49,7 @@ pub use arrays::ArrayPointer;
 pub use check::{GeometryError, Primitive};
 pub use command::Command;
 pub use counters::Counters;
-pub use frame::FrameDraws;
+pub use frame::{Frame, FrameDraws, Instance, MAX_PASSES, Paint, Pass, View};
 pub use geometry::Geometry;
 pub use lighting::{LightState, Lighting, MaterialState, Shading};
 pub use lists::{LIST_BUDGET, MAX_LIST_NESTING};

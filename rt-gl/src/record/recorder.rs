@@ -9,7 +9,8 @@ use std::{
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use super::{
-    Command, Counters, FrameDraws, LIST_BUDGET, Lighting, MaterialState, Recorded, Shading,
+    Command, Counters, Frame, FrameDraws, LIST_BUDGET, Lighting, MAX_PASSES, MaterialState, Pass,
+    Recorded, Shading, View,
     arrays::{ArrayState, DrawKey},
     assemble::Vert,
     capture::{Capture, Inherited},
@@ -37,6 +38,8 @@ pub struct Recorder {
     pub(super) line_width: f32,
     lit: bool,
     flat: bool,
+    /// `GL_NORMALIZE` or `GL_RESCALE_NORMAL` is on.
+    normalize: [bool; 2],
     color_material_on: bool,
     color_material: (u32, u32),
     front: MaterialState,
@@ -55,8 +58,20 @@ pub struct Recorder {
     /// Commands the current top-level list call may still execute.
     pub(super) budget: u64,
     pub(super) list_budget: u64,
-    pub(super) cache: HashMap<u32, Vec<(Inherited, Arc<Recorded>)>>,
-    pub(super) frame: FrameDraws,
+    /// Per list: its recordings, each with the calling state it was
+    /// recorded for and how many of its first vertices took the caller's
+    /// colour.
+    pub(super) cache: HashMap<u32, Vec<(Inherited, Arc<Recorded>, u32)>>,
+    pub(super) frame: Frame,
+    /// `GL_DEPTH_TEST` is on.
+    depth_test: bool,
+    /// `GL_SCISSOR_TEST` is on (a colour clear then clears a rectangle,
+    /// not the frame).
+    scissor: bool,
+    /// The clear colour of the last colour clear.
+    background: Vec4,
+    /// The depth buffer was cleared since the last draw.
+    depth_cleared: bool,
     /// Vertex arrays and buffer objects.
     pub(super) arrays: ArrayState,
     pub(super) draw_cache: HashMap<DrawKey, (Inherited, Arc<Recorded>)>,
@@ -95,6 +110,7 @@ impl Recorder {
             line_width: 1.0,
             lit: false,
             flat: false,
+            normalize: [false; 2],
             color_material_on: false,
             color_material: (gl::FRONT_AND_BACK, gl::AMBIENT_AND_DIFFUSE),
             front: MaterialState::default(),
@@ -110,7 +126,11 @@ impl Recorder {
             budget: LIST_BUDGET,
             list_budget: LIST_BUDGET,
             cache: HashMap::new(),
-            frame: FrameDraws::default(),
+            frame: Frame::default(),
+            depth_test: false,
+            scissor: false,
+            background: Vec4::ZERO,
+            depth_cleared: false,
             arrays: ArrayState::default(),
             draw_cache: HashMap::new(),
             draw_shapes: HashMap::new(),
@@ -134,8 +154,42 @@ impl Recorder {
 
     /// The frame drawn so far.
     #[must_use]
-    pub fn frame(&self) -> &FrameDraws {
+    pub fn frame(&self) -> &Frame {
         &self.frame
+    }
+
+    /// What a draw made now is made under.
+    #[must_use]
+    pub fn view(&self) -> View {
+        View { projection: self.projection(), viewport: self.viewport, depth_test: self.depth_test }
+    }
+
+    /// The pass a draw made now goes into (`lit`: the draw is lit): the
+    /// last one, or a new one if the view changed, the depth buffer was
+    /// cleared, or a lit draw sees other lights than the pass's.
+    pub(super) fn draws(&mut self, lit: bool) -> &mut FrameDraws {
+        let view = self.view();
+        let split = self.frame.passes.last().is_none_or(|p| {
+            p.view != view
+                || self.depth_cleared
+                || (lit && p.draws.lighting.as_ref().is_some_and(|l| *l != self.lighting))
+        });
+        if split && self.frame.passes.len() >= MAX_PASSES {
+            self.counters.passes_merged += 1;
+        } else if split {
+            self.frame.passes.push(Pass {
+                view,
+                depth_cleared: core::mem::take(&mut self.depth_cleared),
+                background: self.background,
+                draws: FrameDraws::default(),
+            });
+        }
+        let lighting = lit.then(|| self.lighting.clone());
+        let pass = self.frame.passes.last_mut().expect("a pass was just pushed if none");
+        if lighting.is_some() {
+            pass.draws.lighting = lighting;
+        }
+        &mut pass.draws
     }
 
     /// Whether a display list is being compiled with `GL_COMPILE` (calls
@@ -146,19 +200,41 @@ impl Recorder {
     }
 
     /// Ends the frame: returns what was drawn and starts an empty one.
-    pub fn end_frame(&mut self) -> FrameDraws {
+    pub fn end_frame(&mut self) -> Frame {
+        let draws = || self.frame.passes.iter().map(|p| &p.draws);
         self.counters.frames += 1;
-        self.counters.instances = self.frame.instances.len() as u64;
-        self.counters.triangles = (self.frame.immediate.triangles.len()
-            + self.frame.instances.iter().map(|(r, _)| r.geometry().triangles.len()).sum::<usize>())
-            as u64;
+        self.counters.passes = self.frame.passes.len() as u64;
+        self.counters.instances = draws().map(|d| d.instances.len()).sum::<usize>() as u64;
+        self.counters.triangles = draws()
+            .map(|d| {
+                d.immediate.triangles.len()
+                    + d.instances
+                        .iter()
+                        .map(|i| i.recorded.geometry().triangles.len())
+                        .sum::<usize>()
+            })
+            .sum::<usize>() as u64;
+        self.depth_cleared = false;
         core::mem::take(&mut self.frame)
     }
 
-    /// `glClear(mask)`: clearing the colour buffer starts the frame over.
+    /// `glClear(mask)`: clearing the colour buffer starts the frame over
+    /// (unless the scissor test limits it to a rectangle: then only the
+    /// passes after it take its colour); clearing the depth buffer alone
+    /// makes the next draws a pass drawn over everything before.
     pub fn clear(&mut self, mask: u32) {
-        if mask & gl::COLOR_BUFFER_BIT != 0 && !self.compiling_only() {
-            self.frame = FrameDraws::default();
+        if self.compiling_only() {
+            return;
+        }
+        let color = mask & gl::COLOR_BUFFER_BIT != 0;
+        if color {
+            self.background = self.clear_color;
+        }
+        if color && !self.scissor {
+            self.frame = Frame::default();
+            self.depth_cleared = false;
+        } else if mask & gl::DEPTH_BUFFER_BIT != 0 && !self.frame.passes.is_empty() {
+            self.depth_cleared = true;
         }
     }
 
@@ -190,10 +266,17 @@ impl Recorder {
     }
 
     pub(super) fn shading(&self) -> Shading {
+        let mut material = self.front;
+        // What colour material covers is the vertex colour at shading
+        // time: kept constant here, so colours alone make no new shading.
+        if self.color_material_on {
+            apply_color_material(&mut material, self.color_material.1, Vec4::ZERO);
+        }
         Shading {
             lit: self.lit,
+            normalize: self.normalize[0] || self.normalize[1],
             flat: self.flat,
-            material: self.front,
+            material,
             color_material: self.color_material_on.then_some(self.color_material.1),
         }
     }
@@ -219,6 +302,11 @@ impl Recorder {
             Command::Normal(n) => self.normal = n,
             Command::Color(col) => {
                 self.color = col;
+                if let Some(c) = &mut self.capture {
+                    // The vertices so far took the caller's colour.
+                    let pending = self.begin.as_ref().map_or(0, |(_, v)| v.len());
+                    c.color_from.get_or_insert(c.geometry.positions.len() + pending);
+                }
                 if self.color_material_on {
                     apply_color_material(&mut self.front, self.color_material.1, col);
                 }
@@ -302,6 +390,10 @@ impl Recorder {
         }
         match cap {
             gl::LIGHTING => self.lit = on,
+            gl::NORMALIZE => self.normalize[0] = on,
+            gl::RESCALE_NORMAL => self.normalize[1] = on,
+            gl::DEPTH_TEST => self.depth_test = on,
+            gl::SCISSOR_TEST => self.scissor = on,
             gl::COLOR_MATERIAL => {
                 self.color_material_on = on;
                 if on {

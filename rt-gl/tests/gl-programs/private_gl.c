@@ -25,6 +25,18 @@
  *                       With `lightsoff`, lighting and the light are
  *                       turned off after the ball is drawn, before the
  *                       swap (as a viewer does before its 2-D overlays).
+ *                       With `overlay`, a mesh generator's frame: a band
+ *                       under the identity projection with the depth
+ *                       test off, behind; the ball under a 3-D glOrtho;
+ *                       then 2-D overlays (a bar, a frame of lines) under
+ *                       a pixel glOrtho, the depth test off.
+ *                       With `viewports`, two views side by side, each
+ *                       cleared under the scissor test: the ball in
+ *                       perspective on the left, under glOrtho and in
+ *                       another colour on the right.
+ *                       With `depthclear`, a second, smaller ball behind
+ *                       the first drawn after glClear(GL_DEPTH_BUFFER_BIT):
+ *                       GL shows it in front.
  *
  * Build: cc -O2 -o private_gl private_gl.c -lX11 -ldl -lm
  */
@@ -159,6 +171,16 @@ int main(int argc, char **argv) {
     void (*rectf)(GLfloat, GLfloat, GLfloat, GLfloat) = (void *)need("glRectf");
     void (*frontFace)(GLenum) = (void *)need("glFrontFace");
     void (*lightModeli)(GLenum, GLint) = (void *)need("glLightModeli");
+    void (*ortho)(GLdouble, GLdouble, GLdouble, GLdouble, GLdouble, GLdouble) =
+        (void *)need("glOrtho");
+    void (*scissor)(GLint, GLint, GLsizei, GLsizei) = (void *)need("glScissor");
+    void (*lineWidth)(GLfloat) = (void *)need("glLineWidth");
+    void (*vertex2f)(GLfloat, GLfloat) = (void *)need("glVertex2f");
+    void (*scalef)(GLfloat, GLfloat, GLfloat) = (void *)need("glScalef");
+    const char *mode = argc >= 3 ? argv[2] : "";
+    int overlay = strcmp(mode, "overlay") == 0;
+    int viewports = strcmp(mode, "viewports") == 0;
+    int depthclear = strcmp(mode, "depthclear") == 0;
 
     if (clockwise) {
         frontFace(GL_CW);
@@ -205,6 +227,105 @@ int main(int argc, char **argv) {
     enable(GL_COLOR_MATERIAL);
     GLfloat pos[4] = {1.0f, 2.0f, 3.0f, 0.0f};
     for (int f = 0; f < frames; f++) {
+        if (overlay || viewports || depthclear) {
+            /* The views of the frame, whole in themselves. */
+            if (overlay) {
+                clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                /* A band behind everything, in normalized device
+                 * coordinates: identity matrices, no depth test. */
+                matrixMode(GL_PROJECTION);
+                loadIdentity();
+                matrixMode(GL_MODELVIEW);
+                loadIdentity();
+                disable(GL_DEPTH_TEST);
+                disable(GL_LIGHTING);
+                begin(GL_QUADS);
+                color3f(0.25f, 0.3f, 0.45f);
+                vertex2f(-1.0f, 0.2f);
+                vertex2f(1.0f, 0.2f);
+                color3f(0.5f, 0.55f, 0.7f);
+                vertex2f(1.0f, 1.0f);
+                vertex2f(-1.0f, 1.0f);
+                end();
+                /* The mesh under a 3-D glOrtho, lit, depth-tested. */
+                enable(GL_DEPTH_TEST);
+                enable(GL_LIGHTING);
+                matrixMode(GL_PROJECTION);
+                loadIdentity();
+                ortho(-2.0, 2.0, -2.0, 2.0, -10.0, 10.0);
+                matrixMode(GL_MODELVIEW);
+                loadIdentity();
+                lightfv(GL_LIGHT0, GL_POSITION, pos);
+                rotatef(20.0f * f, 0.3f, 1.0f, 0.0f);
+                p_color3f(0.9f, 0.5f, 0.2f);
+                ball();
+                /* 2-D overlays in pixels: a bar and a frame of lines. */
+                disable(GL_DEPTH_TEST);
+                disable(GL_LIGHTING);
+                matrixMode(GL_PROJECTION);
+                loadIdentity();
+                ortho(0.0, 256.0, 0.0, 256.0, -1.0, 1.0);
+                matrixMode(GL_MODELVIEW);
+                loadIdentity();
+                color3f(0.9f, 0.9f, 0.3f);
+                rectf(16.0f, 8.0f, 16.0f + 4.0f * (float)(f + 1), 20.0f);
+                lineWidth(2.0f);
+                color3f(0.2f, 0.9f, 0.4f);
+                begin(GL_LINE_LOOP);
+                vertex2f(4.0f, 4.0f);
+                vertex2f(252.0f, 4.0f);
+                vertex2f(252.0f, 252.0f);
+                vertex2f(4.0f, 252.0f);
+                end();
+                lineWidth(1.0f);
+                enable(GL_DEPTH_TEST);
+                enable(GL_LIGHTING);
+            } else if (viewports) {
+                enable(GL_SCISSOR_TEST);
+                for (int side = 0; side < 2; side++) {
+                    viewport(128 * side, 0, 128, 256);
+                    scissor(128 * side, 0, 128, 256);
+                    clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                    matrixMode(GL_PROJECTION);
+                    loadIdentity();
+                    if (side == 0)
+                        frustum(-0.3, 0.3, -0.6, 0.6, 1.0, 20.0);
+                    else
+                        ortho(-1.0, 1.0, -2.0, 2.0, -10.0, 10.0);
+                    matrixMode(GL_MODELVIEW);
+                    loadIdentity();
+                    lightfv(GL_LIGHT0, GL_POSITION, pos);
+                    if (side == 0) translatef(0.0f, 0.0f, -4.0f);
+                    rotatef(20.0f * f, 0.3f, 1.0f, 0.0f);
+                    scalef(0.7f, 0.7f, 0.7f);
+                    if (side == 0) p_color3f(0.9f, 0.5f, 0.2f);
+                    else p_color3f(0.3f, 0.6f, 0.9f);
+                    ball();
+                }
+                disable(GL_SCISSOR_TEST);
+            } else {
+                clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                matrixMode(GL_PROJECTION);
+                loadIdentity();
+                frustum(-0.6, 0.6, -0.6, 0.6, 1.0, 20.0);
+                matrixMode(GL_MODELVIEW);
+                loadIdentity();
+                lightfv(GL_LIGHT0, GL_POSITION, pos);
+                translatef(0.0f, 0.0f, -4.0f);
+                rotatef(20.0f * f, 0.3f, 1.0f, 0.0f);
+                p_color3f(0.9f, 0.5f, 0.2f);
+                ball();
+                /* Behind the first ball, drawn over it. */
+                clear(GL_DEPTH_BUFFER_BIT);
+                loadIdentity();
+                translatef(0.6f, 0.4f, -7.0f);
+                p_color3f(0.3f, 0.6f, 0.9f);
+                ball();
+            }
+            swapBuffers(dpy, win);
+            finish();
+            continue;
+        }
         clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
         matrixMode(GL_PROJECTION);
         loadIdentity();

@@ -1,0 +1,143 @@
+//! A frame's passes put together as GL's depth buffer puts its draws
+//! together: in the order drawn, a pass's pixel replacing what is there
+//! when the pass's depth test is off or its depth is not greater than
+//! the depth buffer's, which a depth clear between passes resets.
+//!
+//! Traced 3-D passes give colours and depths; 2-D overlays give only
+//! where they cover and how deep (traced without shading), their colour
+//! being GL's own raster, kept in the window: the composite marks those
+//! pixels with alpha 0 and is drawn over the program's back buffer with
+//! the alpha test, so GL's overlay shows through exactly as it drew it.
+//! A pass that could not be traced keeps its whole viewport as GL drew
+//! it. Where no pass covers a pixel inside a traced pass's viewport, the
+//! composite shows the clear colour of that pass's frame; outside every
+//! traced viewport, GL's pixel stays.
+
+use glam::Vec4;
+
+use crate::render::{Image, to_rgba8};
+
+/// What one pass contributes.
+#[derive(Clone, Debug)]
+pub enum Content {
+    /// Ray traced: RGBA and window depth per pixel of the viewport
+    /// (`f32::INFINITY`: nothing hit), rows bottom to top.
+    Traced {
+        /// The traced colours.
+        image: Image,
+        /// The window depths.
+        depth: Vec<f32>,
+    },
+    /// A 2-D overlay, shown from GL's raster where it covers: window
+    /// depth per pixel of the viewport (`f32::INFINITY`: not covered).
+    Raster {
+        /// The window depths.
+        depth: Vec<f32>,
+    },
+    /// Not traced (an error): the whole viewport shows GL's raster.
+    Untraced,
+}
+
+/// One pass, placed in the window.
+#[derive(Clone, Debug)]
+pub struct Layer {
+    /// Window rectangle `[x, y, width, height]` the content covers.
+    pub viewport: [i32; 4],
+    /// The pass's depth test was on.
+    pub depth_test: bool,
+    /// The depth buffer was cleared before the pass.
+    pub depth_cleared: bool,
+    /// Clear colour behind a traced pass.
+    pub background: Vec4,
+    /// The pixels.
+    pub content: Content,
+}
+
+/// A 2-D overlay's coverage `depth` (over viewport `v`) at `(x, y)`, or
+/// where it does not cover that pixel, the nearest of its eight
+/// neighbours': one ray per pixel centre misses some pixels GL's
+/// rasterizer covers (thin lines, points, edges), and a pixel GL drew
+/// must show what GL drew.
+fn near(depth: &[f32], v: [i32; 4], x: i32, y: i32) -> f32 {
+    let own = (y - v[1]) as usize * v[2] as usize + (x - v[0]) as usize;
+    let mut z = depth.get(own).copied().unwrap_or(f32::INFINITY);
+    if z.is_finite() {
+        return z;
+    }
+    for dy in -1..=1 {
+        for dx in -1..=1 {
+            let (px, py) = (x + dx - v[0], y + dy - v[1]);
+            if px >= 0 && py >= 0 && px < v[2] && py < v[3] {
+                let i = py as usize * v[2] as usize + px as usize;
+                z = z.min(depth.get(i).copied().unwrap_or(f32::INFINITY));
+            }
+        }
+    }
+    z
+}
+
+/// Whether the composite has any pixel GL's raster must show (alpha 0).
+#[must_use]
+pub fn keeps_raster(image: &Image) -> bool {
+    image.rgba.chunks_exact(4).any(|p| p[3] == 0)
+}
+
+/// The composite over the window rectangle `window` (`[x, y, width,
+/// height]`): opaque where a traced pass or its background shows, alpha 0
+/// where GL's raster is to stay.
+#[must_use]
+pub fn composite(window: [i32; 4], layers: &[Layer]) -> Image {
+    let [wx, wy, ww, wh] = window.map(|v| v.max(0));
+    let mut rgba = vec![0u8; 4 * ww as usize * wh as usize];
+    let inside =
+        |v: [i32; 4], x: i32, y: i32| x >= v[0] && y >= v[1] && x - v[0] < v[2] && y - v[1] < v[3];
+    for (row, y) in rgba.chunks_exact_mut(4 * ww.max(1) as usize).zip(wy..) {
+        for (px, x) in row.chunks_exact_mut(4).zip(wx..) {
+            let mut depth = 1.0f32;
+            let mut winner: Option<(&Layer, usize)> = None;
+            let mut background = None;
+            for l in layers {
+                if l.depth_cleared {
+                    depth = 1.0;
+                }
+                let v = l.viewport;
+                if !inside(v, x, y) {
+                    continue;
+                }
+                let i = (y - v[1]) as usize * v[2] as usize + (x - v[0]) as usize;
+                let z = match &l.content {
+                    Content::Traced { depth, .. } => {
+                        background = Some(l.background);
+                        depth.get(i).copied().unwrap_or(f32::INFINITY)
+                    }
+                    Content::Raster { depth } => near(depth, v, x, y),
+                    Content::Untraced => {
+                        winner = Some((l, i));
+                        continue;
+                    }
+                };
+                if !z.is_finite() {
+                    continue;
+                }
+                if !l.depth_test {
+                    winner = Some((l, i));
+                } else if z <= depth {
+                    winner = Some((l, i));
+                    depth = z;
+                }
+            }
+            let c = match winner {
+                Some((Layer { content: Content::Traced { image, .. }, .. }, i)) => {
+                    image.rgba.get(4 * i..4 * i + 3).map(|c| [c[0], c[1], c[2], 255])
+                }
+                Some(_) => None,
+                None => background.map(|b| {
+                    let c = to_rgba8(b);
+                    [c[0], c[1], c[2], 255]
+                }),
+            };
+            px.copy_from_slice(&c.unwrap_or([0; 4]));
+        }
+    }
+    Image { width: ww as u32, height: wh as u32, rgba }
+}
