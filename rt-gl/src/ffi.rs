@@ -63,7 +63,8 @@ fn param_count(pname: u32) -> usize {
         | gl::POSITION
         | gl::EMISSION
         | gl::AMBIENT_AND_DIFFUSE
-        | gl::LIGHT_MODEL_AMBIENT => 4,
+        | gl::LIGHT_MODEL_AMBIENT
+        | gl::FOG_COLOR => 4,
         _ => 1,
     }
 }
@@ -94,7 +95,8 @@ fn int_param(pname: u32, v: Vec4) -> Vec4 {
         | gl::SPECULAR
         | gl::EMISSION
         | gl::AMBIENT_AND_DIFFUSE
-        | gl::LIGHT_MODEL_AMBIENT => v / 2_147_483_647.0,
+        | gl::LIGHT_MODEL_AMBIENT
+        | gl::FOG_COLOR => v / 2_147_483_647.0,
         _ => v,
     }
 }
@@ -232,7 +234,13 @@ intercept! {
     glClearColor(r: f32, g: f32, b: f32, a: f32) { with_recorder(|rec| rec.clear_color = Vec4::new(r, g, b, a).clamp(Vec4::ZERO, Vec4::ONE)) }
     glClear(mask: u32) { with_recorder(|r| r.clear(mask)) }
     glEnable(cap: u32) { rec(Command::Enable(cap)) }
-    glPolygonMode(face: u32, mode: u32) { let _ = face; if mode != 0x1B02 { unsupported("glPolygonMode(GL_LINE|GL_POINT)") } }
+    glPolygonMode(face: u32, mode: u32) { rec(Command::PolygonMode(face, mode)) }
+    glFogf(pname: u32, v: f32) { rec(Command::Fog(pname, Vec4::new(v, 0.0, 0.0, 0.0))) }
+    glFogi(pname: u32, v: i32) { rec(Command::Fog(pname, Vec4::new(v as f32, 0.0, 0.0, 0.0))) }
+    glFogfv(pname: u32, v: *const f32) { if let Some(p) = unsafe { params(pname, v) } { rec(Command::Fog(pname, p)) } }
+    glFogiv(pname: u32, v: *const i32) { if let Some(p) = unsafe { params(pname, v) } { rec(Command::Fog(pname, int_param(pname, p))) } }
+    glBlendFunc(src: u32, dst: u32) { rec(Command::BlendFunc(src, dst)) }
+    glCullFace(face: u32) { rec(Command::CullFace(face)) }
     glFrontFace(mode: u32) { rec(Command::FrontFace(mode)) }
     glRectf(x1: f32, y1: f32, x2: f32, y2: f32) { rect(x1, y1, x2, y2) }
     glRectd(x1: f64, y1: f64, x2: f64, y2: f64) { rect(x1 as f32, y1 as f32, x2 as f32, y2 as f32) }

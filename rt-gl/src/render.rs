@@ -21,8 +21,9 @@ use rt_core::{
     Hit, PrimKind, Ray, SceneQuery, camera::cosine_hemisphere, sampling, spawn_ray, spawn_ray_to,
 };
 
+use crate::gl;
 use crate::record::{
-    FrameDraws, Geometry, GeometryError, Lighting, Paint, Recorded, Shading, normal_matrix,
+    Fog, FrameDraws, Geometry, GeometryError, Lighting, Paint, Recorded, Shading, normal_matrix,
 };
 
 /// How frames are lit: GL's fixed-function model, or ray-traced.
@@ -38,6 +39,8 @@ pub enum Illumination {
 /// Deepest reflection [`Options::bounces`] may ask for: reflections
 /// recurse on the tracing thread's stack.
 pub const MAX_BOUNCES: u32 = 16;
+/// Most blended surfaces one primary ray is traced through.
+pub const MAX_LAYERS: usize = 16;
 /// Most ambient-occlusion rays per pixel [`Options::ao_samples`] may ask
 /// for.
 pub const MAX_AO_SAMPLES: u32 = 1024;
@@ -192,6 +195,8 @@ pub struct FrameScene {
     normal: Vec<Mat3>,
     /// Per instance: what its call paints it with.
     paint: Vec<Option<Paint>>,
+    /// The pass's fog, for its fogged primitives.
+    fog: Option<Fog>,
     diagonal: f32,
     left_out: usize,
 }
@@ -246,7 +251,16 @@ impl FrameScene {
         let instances = Instances::new(objects, &placements).map_err(RenderError::Instance)?;
         let b = Object::bounds(&scene).union(instances.bounds());
         let diagonal = if b.is_empty() { 0.0 } else { (b.max - b.min).length() };
-        Ok(Self { immediate: frame.immediate, scene, instances, normal, paint, diagonal, left_out })
+        Ok(Self {
+            immediate: frame.immediate,
+            scene,
+            instances,
+            normal,
+            paint,
+            fog: frame.fog,
+            diagonal,
+            left_out,
+        })
     }
 
     /// Instances left out of the trace: their transforms cannot place them
@@ -256,8 +270,38 @@ impl FrameScene {
         self.left_out
     }
 
-    /// The closest hit among the immediate geometry and the instances.
+    /// The closest hit among the immediate geometry and the instances,
+    /// past the faces culled (`glCullFace`): up to [`MAX_LAYERS`] of them,
+    /// each passed through as the ray's next segment.
     fn closest(&self, ray: &Ray) -> Option<(Source, Hit)> {
+        // The distance passed through culled faces, in the ray's units
+        // (its direction is kept): hits are measured from its origin.
+        let (mut r, mut passed) = (*ray, 0.0);
+        for _ in 0..MAX_LAYERS {
+            let (src, mut hit) = self.closest_any(&r)?;
+            let back = hit.normal.dot(r.direction) > 0.0;
+            let culled = hit.kind == PrimKind::Triangle
+                && match self.surface(src, &hit).0.cull {
+                    gl::FRONT_AND_BACK => true,
+                    gl::BACK => back,
+                    gl::FRONT => !back,
+                    _ => false,
+                };
+            if !culled {
+                hit.t += passed;
+                return Some((src, hit));
+            }
+            passed += hit.t;
+            let side = if back { hit.normal } else { -hit.normal };
+            let mut on = spawn_ray(hit.position, hit.position_error, side, r.direction);
+            on.t_max = (r.t_max - hit.t).max(0.0);
+            r = on;
+        }
+        None
+    }
+
+    /// The closest hit, culled or not.
+    fn closest_any(&self, ray: &Ray) -> Option<(Source, Hit)> {
         let a = SceneQuery::closest_hit(&self.scene, ray);
         let r = Ray { t_max: a.map_or(ray.t_max, |h| h.t), ..*ray };
         match self.instances.closest_hit_instance(&r) {
@@ -364,7 +408,7 @@ impl FrameScene {
             }
             if let (Some(px), Some(s), Some(bg)) = (px, shade, bg) {
                 let c = match hit {
-                    Some((src, hit)) => {
+                    Some(first) => {
                         let seed = (y as u64) << 32 | x as u64;
                         let ctx = ShadeCtx {
                             lighting: s.lighting,
@@ -372,7 +416,7 @@ impl FrameScene {
                             background: s.background,
                             seed,
                         };
-                        to_rgba8(self.shade(&ray, src, &hit, &ctx, 0))
+                        to_rgba8(self.shade_through(&ray, first, &ctx))
                     }
                     None => bg,
                 };
@@ -469,12 +513,62 @@ impl FrameScene {
     }
 
     /// GL's lighting equation at `hit`, per pixel.
+    /// The colour at `hit`: lit (or the vertex colour, unlit), fogged;
+    /// alpha its own where it is blended, 1 where it is opaque.
     fn shade(&self, ray: &Ray, src: Source, hit: &Hit, ctx: &ShadeCtx<'_>, depth: u32) -> Vec4 {
-        let ShadeCtx { lighting, opts, seed, .. } = *ctx;
         let (sh, color, normal, length) = self.surface(src, hit);
-        if !sh.lit {
-            return color;
+        let mut c = if sh.lit {
+            self.light(ray, hit, (&sh, color, normal, length), ctx, depth)
+        } else {
+            color
+        };
+        if let (true, Some(fog)) = (sh.fog, &self.fog) {
+            // GL's fog coordinate: the eye-space depth's magnitude.
+            let f = fog.factor(hit.position.z.abs());
+            c = (c.truncate() * f + fog.color.truncate() * (1.0 - f)).extend(c.w);
         }
+        if !sh.blend {
+            c.w = 1.0;
+        }
+        c
+    }
+
+    /// Front to back through blended surfaces, each over what lies behind
+    /// it (at most [`MAX_LAYERS`] of them; the background behind the last).
+    /// Sorted by depth whatever order they were drawn in: GL's image of
+    /// the same surfaces drawn back to front.
+    fn shade_through(&self, ray: &Ray, first: (Source, Hit), ctx: &ShadeCtx<'_>) -> Vec4 {
+        let (mut acc, mut through) = (Vec3::ZERO, 1.0f32);
+        let (mut r, mut next) = (*ray, Some(first));
+        for _ in 0..MAX_LAYERS {
+            let Some((src, hit)) = next else { break };
+            let c = self.shade(&r, src, &hit, ctx, 0);
+            let a = c.w.clamp(0.0, 1.0);
+            acc += through * a * c.truncate();
+            through *= 1.0 - a;
+            if through < 1.0 / 1024.0 {
+                return acc.extend(1.0);
+            }
+            // On past the surface, as far as the far plane.
+            let side = if r.direction.dot(hit.normal) > 0.0 { hit.normal } else { -hit.normal };
+            let mut on = spawn_ray(hit.position, hit.position_error, side, r.direction);
+            on.t_max = (r.t_max - hit.t).max(0.0);
+            r = on;
+            next = self.closest(&r);
+        }
+        (acc + through * ctx.background.truncate()).extend(1.0)
+    }
+
+    /// GL's lighting equation at `hit`, per pixel.
+    fn light(
+        &self,
+        ray: &Ray,
+        hit: &Hit,
+        (sh, color, normal, length): (&Shading, Vec4, Vec3, f32),
+        ctx: &ShadeCtx<'_>,
+        depth: u32,
+    ) -> Vec4 {
+        let ShadeCtx { lighting, opts, seed, .. } = *ctx;
         // Spheres and tubes carry their own normal; triangles the one
         // the program gave, whose length GL keeps in the lighting dot
         // products unless GL_NORMALIZE is on (`gain`).

@@ -31,13 +31,7 @@ fn projection() -> Mat4 {
 
 /// Unlit: the image shows the vertex colours as they are.
 fn unlit() -> Shading {
-    Shading {
-        lit: false,
-        flat: false,
-        material: MaterialState::default(),
-        color_material: None,
-        normalize: false,
-    }
+    Shading::default()
 }
 
 /// A red triangle at z = −3, a green sphere and a blue tube in front of
@@ -91,7 +85,7 @@ fn instanced(g: Geometry) -> FrameDraws {
                 paint: None,
             },
         ],
-        lighting: None,
+        ..FrameDraws::default()
     }
 }
 
@@ -252,10 +246,8 @@ fn malformed_geometry_is_refused_everywhere() {
 fn hall_of_mirrors() -> Geometry {
     let mirror = Shading {
         lit: true,
-        flat: false,
         material: MaterialState { specular: Vec4::ONE, ..MaterialState::default() },
-        color_material: None,
-        normalize: false,
+        ..Shading::default()
     };
     let mut g = Geometry { shadings: vec![mirror], ..Geometry::default() };
     for (z, n) in [(-3.0, Vec3::Z), (1.0, Vec3::NEG_Z)] {

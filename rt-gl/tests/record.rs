@@ -95,6 +95,7 @@ fn primitives_assemble_into_consistently_oriented_triangles() {
 
 /// Points become spheres and lines tubes whose radius is half the size
 /// in pixels at the primitive's depth: twice as deep, twice as wide.
+/// Lines are as wide across as GL draws them.
 #[test]
 fn points_and_lines_get_their_pixel_size_at_their_depth() {
     let mut r = Recorder::new();
@@ -110,9 +111,13 @@ fn points_and_lines_get_their_pixel_size_at_their_depth() {
     // At depth 2 the 200-pixel view is 4 units tall: 10 px = 0.2 units.
     assert!((g.spheres[0].1 - 0.1).abs() < 1e-6, "{:?}", g.spheres);
     assert!((g.spheres[1].1 - 0.2).abs() < 1e-6);
-    // A loop of three vertices is three tubes.
+    // A loop of three vertices is three tubes: 4 px = 0.12 units at depth
+    // 3, GL's width along the window's minor axis, so narrower across a
+    // slanted line by max(|dx|, |dy|)/|d| (GL 2.1 §3.4.2).
     assert_eq!(g.tubes.len(), 3);
-    assert!((g.tubes[0].1 - 0.06).abs() < 1e-6, "{:?}", g.tubes[0]);
+    let d = ring(3)[1] - ring(3)[0];
+    let across = 0.06 * d.x.abs().max(d.y.abs()) / d.length();
+    assert!((g.tubes[0].1 - across).abs() < 1e-6, "{:?}", g.tubes[0]);
 }
 
 fn gear_like_list(r: &mut Recorder, id: u32, color: Vec4) {

@@ -485,7 +485,8 @@ impl Recorder {
     /// As [`Self::emit`].
     unsafe fn draw(&mut self, mode: u32, idx: Indices) {
         let points_or_lines =
-            matches!(mode, gl::POINTS | gl::LINES | gl::LINE_LOOP | gl::LINE_STRIP);
+            matches!(mode, gl::POINTS | gl::LINES | gl::LINE_LOOP | gl::LINE_STRIP)
+                || self.polygon_mode != [gl::FILL; 2];
         let plain = self.compiling.is_none()
             && self.state_only == 0
             && self.capture.is_none()

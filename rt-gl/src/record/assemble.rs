@@ -34,8 +34,33 @@ impl Recorder {
         (2.0 * w.abs() / (p.y_axis.y.abs() * h)).max(f32::MIN_POSITIVE)
     }
 
+    /// How much thinner than its width, across itself, GL draws a line
+    /// from eye-space `a` to `b` under projection `p` in viewport `v`: a
+    /// non-antialiased line of width `w` covers `w` pixels along the
+    /// window's minor axis (x for a steep line, y for a flat one), so
+    /// `w·max(|dx|, |dy|)/|d|` across it.
+    fn line_slant(p: Mat4, v: [i32; 4], a: Vec3, b: Vec3) -> f32 {
+        let [_, _, w, h] = v;
+        let (w, h) = (w.max(1) as f32, h.max(1) as f32);
+        let window = |e: Vec3| {
+            let c = p * e.extend(1.0);
+            glam::Vec2::new(c.x / c.w * w, c.y / c.w * h) * 0.5
+        };
+        let d = window(b) - window(a);
+        let f = d.abs().max_element() / d.length();
+        if f.is_finite() { f.clamp(core::f32::consts::FRAC_1_SQRT_2, 1.0) } else { 1.0 }
+    }
+
     /// Turns one `glBegin`/`glEnd` into triangles, spheres or tubes.
     pub(super) fn assemble(&mut self, mode: u32, verts: &[Vert]) {
+        // `glPolygonMode`: polygons drawn as their edges or corners (the
+        // front faces' mode; back faces are taken the same).
+        let polygon = (gl::TRIANGLES..=gl::POLYGON).contains(&mode);
+        let mode = match self.polygon_mode[0] {
+            gl::LINE if polygon => return self.assemble_outlines(mode, verts),
+            gl::POINT if polygon => gl::POINTS,
+            _ => mode,
+        };
         let shading = self.shading();
         let point_r = self.point_size * 0.5;
         let line_r = self.line_width * 0.5;
@@ -49,10 +74,11 @@ impl Recorder {
         // Clockwise front faces: each triangle reversed, so its geometric
         // normal points where GL's front does.
         let cw = self.front_cw;
+        let view = (self.projection(), self.viewport);
         let (g, to_local, n_to_local) = if let Some(c) = &mut self.capture {
             (&mut c.geometry, c.to_local, c.normal_to_local)
         } else {
-            (&mut self.draws(shading.lit).immediate, Mat4::IDENTITY, Mat3::IDENTITY)
+            (&mut self.draws(shading.lit, shading.fog).immediate, Mat4::IDENTITY, Mat3::IDENTITY)
         };
         let base = g.positions.len() as u32;
         for &(p, n, c) in verts {
@@ -98,10 +124,47 @@ impl Recorder {
                     _ => Vec::new(),
                 };
                 for [a, b] in seg {
-                    let r = 0.5 * (radius[a as usize] + radius[b as usize]);
+                    let (pa, pb) = (verts[a as usize].0, verts[b as usize].0);
+                    let r = 0.5
+                        * (radius[a as usize] + radius[b as usize])
+                        * Self::line_slant(view.0, view.1, pa, pb);
                     g.tubes.push(([v(a), v(b)], r, s));
                 }
             }
         }
+    }
+
+    /// `glPolygonMode(GL_LINE)`: each polygon's edges as lines (a quad's
+    /// four sides, not its diagonal), each edge once.
+    fn assemble_outlines(&mut self, mode: u32, verts: &[Vert]) {
+        let n = verts.len();
+        let mut polygons: Vec<Vec<usize>> = Vec::new();
+        match mode {
+            gl::TRIANGLES => {
+                (0..n / 3).for_each(|i| polygons.push(vec![3 * i, 3 * i + 1, 3 * i + 2]))
+            }
+            gl::TRIANGLE_STRIP => {
+                (0..n.saturating_sub(2)).for_each(|i| polygons.push(vec![i, i + 1, i + 2]));
+            }
+            gl::TRIANGLE_FAN => {
+                (1..n.saturating_sub(1)).for_each(|i| polygons.push(vec![0, i, i + 1]));
+            }
+            gl::QUADS => (0..n / 4).for_each(|q| polygons.push((4 * q..4 * q + 4).collect())),
+            gl::QUAD_STRIP => (0..n.saturating_sub(2) / 2)
+                .for_each(|q| polygons.push(vec![2 * q, 2 * q + 1, 2 * q + 3, 2 * q + 2])),
+            _ if n >= 3 => polygons.push((0..n).collect()),
+            _ => {}
+        }
+        let mut seen = std::collections::HashSet::new();
+        let mut segments: Vec<Vert> = Vec::new();
+        for p in &polygons {
+            for (k, &a) in p.iter().enumerate() {
+                let b = p[(k + 1) % p.len()];
+                if seen.insert((a.min(b), a.max(b))) {
+                    segments.extend([verts[a], verts[b]]);
+                }
+            }
+        }
+        self.assemble(gl::LINES, &segments);
     }
 }

@@ -94,12 +94,13 @@ impl Recorder {
     /// Adds an instance of cached geometry to the frame.
     pub(super) fn instance(&mut self, recorded: Arc<Recorded>, mv: Mat4, paint: Option<Paint>) {
         if !recorded.geometry().is_empty() && self.state_only == 0 {
-            let lit = match &paint {
-                Some(p) => p.shading.lit,
-                None => recorded.geometry().shadings.iter().any(|s| s.lit),
+            let shadings = recorded.geometry().shadings.iter();
+            let (lit, fogged) = match &paint {
+                Some(p) => (p.shading.lit, p.shading.fog),
+                None => shadings.fold((false, false), |(l, f), s| (l || s.lit, f || s.fog)),
             };
             let inst = Instance { recorded, transform: mv, paint };
-            self.draws(lit).instances.push(inst);
+            self.draws(lit, fogged).instances.push(inst);
         }
     }
 

@@ -51,4 +51,12 @@ pub enum Command {
     LineWidth(f32),
     /// `glCallList`.
     CallList(u32),
+    /// `glPolygonMode(face, mode)`.
+    PolygonMode(u32, u32),
+    /// `glFog*(pname, value)` (scalars in `value[0]`).
+    Fog(u32, Vec4),
+    /// `glBlendFunc(source, destination)`.
+    BlendFunc(u32, u32),
+    /// `glCullFace(face)`.
+    CullFace(u32),
 }

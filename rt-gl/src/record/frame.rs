@@ -5,8 +5,8 @@
 //! frame may hold a 3-D pass, a 2-D overlay in pixel coordinates drawn
 //! over it, and a second 3-D pass in another viewport. The recorder
 //! starts a new [`Pass`] whenever the view a draw is made under differs
-//! from the last pass's, the depth buffer was cleared, or a lit draw
-//! sees other lights than the pass's earlier ones; the renderer traces
+//! from the last pass's, the depth buffer was cleared, or a lit (fogged)
+//! draw sees other lights (fog) than the pass's earlier ones; the renderer traces
 //! each 3-D pass in its own rectangle and composites them as GL's depth
 //! buffer would (see `composite.rs`).
 
@@ -14,7 +14,7 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec4};
 
-use super::{Geometry, GeometryError, Lighting, Recorded, Shading};
+use super::{Fog, Geometry, GeometryError, Lighting, Recorded, Shading};
 
 /// Most passes kept in one frame: past it, draws join the last pass
 /// (counted in [`Counters::passes_merged`](super::Counters::passes_merged)),
@@ -80,6 +80,9 @@ pub struct FrameDraws {
     /// lit was drawn): a program may turn its lights off after its 3-D
     /// pass, before the swap, as GL only applies them per draw.
     pub lighting: Option<Lighting>,
+    /// The fog in force at the pass's last fogged draw (`None`: nothing
+    /// fogged was drawn).
+    pub fog: Option<Fog>,
 }
 
 impl FrameDraws {
@@ -181,6 +184,7 @@ impl Frame {
             }
             all.instances.extend(d.instances);
             all.lighting = d.lighting.or(all.lighting);
+            all.fog = d.fog.or(all.fog);
         }
         all
     }

@@ -94,6 +94,43 @@ impl Default for Lighting {
     }
 }
 
+/// GL's fog: the fragment's colour blended toward `color` by its eye
+/// distance (OpenGL 2.1 §3.10).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fog {
+    /// `GL_FOG_MODE`: `GL_LINEAR`, `GL_EXP` or `GL_EXP2`.
+    pub mode: u32,
+    /// `GL_FOG_DENSITY` (`GL_EXP`, `GL_EXP2`).
+    pub density: f32,
+    /// `GL_FOG_START` (`GL_LINEAR`).
+    pub start: f32,
+    /// `GL_FOG_END` (`GL_LINEAR`).
+    pub end: f32,
+    /// `GL_FOG_COLOR`.
+    pub color: Vec4,
+}
+
+impl Default for Fog {
+    fn default() -> Self {
+        Self { mode: gl::EXP, density: 1.0, start: 0.0, end: 1.0, color: Vec4::ZERO }
+    }
+}
+
+impl Fog {
+    /// The share of the fragment's own colour at eye distance `z`
+    /// (GL's `f`, clamped to `[0, 1]`).
+    #[must_use]
+    pub fn factor(&self, z: f32) -> f32 {
+        let f = match self.mode {
+            gl::LINEAR if self.end != self.start => (self.end - z) / (self.end - self.start),
+            gl::LINEAR => 1.0,
+            gl::EXP2 => (-(self.density * z) * (self.density * z)).exp(),
+            _ => (-self.density * z).exp(),
+        };
+        if f.is_nan() { 1.0 } else { f.clamp(0.0, 1.0) }
+    }
+}
+
 /// How a primitive is shaded, besides its vertices' colours and normals
 /// (default: GL's initial state, unlit).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -112,6 +149,14 @@ pub struct Shading {
     /// modelview left it, so a scaled object lights brighter or darker,
     /// and so does the trace.
     pub normalize: bool,
+    /// `GL_FOG` was on: the pass's [`Fog`] applies.
+    pub fog: bool,
+    /// `GL_BLEND` was on with `glBlendFunc(GL_SRC_ALPHA,
+    /// GL_ONE_MINUS_SRC_ALPHA)`: the surface is seen through by its alpha.
+    pub blend: bool,
+    /// `GL_CULL_FACE` was on: the faces culled (`GL_BACK`, `GL_FRONT`,
+    /// `GL_FRONT_AND_BACK`; 0: none). Rays pass through them.
+    pub cull: u32,
 }
 
 impl Shading {

@@ -154,6 +154,7 @@ impl Recorder {
                     | Command::LoadMatrix(_)
                     | Command::MatrixMode(_)
                     | Command::Begin(gl::POINTS | gl::LINES | gl::LINE_LOOP | gl::LINE_STRIP)
+                    | Command::PolygonMode(_, gl::LINE | gl::POINT)
             )
         });
         let nested = commands.iter().any(|c| matches!(c, Command::CallList(_)));
@@ -229,7 +230,9 @@ impl Recorder {
         let mv = self.modelview();
         let plain = self.state_only == 0 && self.capture.is_none() && self.begin.is_none();
         match Self::to_local(&mv) {
-            Some(to_local) if plain && list.cacheable => {
+            // Polygons drawn as lines or points are sized in pixels at
+            // their depth, as lines are: not recordable once.
+            Some(to_local) if plain && list.cacheable && self.polygon_mode == [gl::FILL; 2] => {
                 let mut key = list.overrides.mask(self.inherited(if list.nested {
                     self.generation
                 } else {

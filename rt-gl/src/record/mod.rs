@@ -51,7 +51,7 @@ pub use command::Command;
 pub use counters::Counters;
 pub use frame::{Frame, FrameDraws, Instance, MAX_PASSES, Paint, Pass, View};
 pub use geometry::Geometry;
-pub use lighting::{LightState, Lighting, MaterialState, Shading};
+pub use lighting::{Fog, LightState, Lighting, MaterialState, Shading};
 pub use lists::{LIST_BUDGET, MAX_LIST_NESTING};
 pub use matrix::{frustum, normal_matrix, ortho, rotate, scale, translate};
 pub use recorded::Recorded;

@@ -9,8 +9,8 @@ use std::{
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use super::{
-    Command, Counters, Frame, FrameDraws, LIST_BUDGET, Lighting, MAX_PASSES, MaterialState, Pass,
-    Recorded, Shading, View,
+    Command, Counters, Fog, Frame, FrameDraws, LIST_BUDGET, Lighting, MAX_PASSES, MaterialState,
+    Pass, Recorded, Shading, View,
     arrays::{ArrayState, DrawKey},
     assemble::Vert,
     capture::{Capture, Inherited},
@@ -40,6 +40,18 @@ pub struct Recorder {
     flat: bool,
     /// `GL_NORMALIZE` or `GL_RESCALE_NORMAL` is on.
     normalize: [bool; 2],
+    /// `GL_FOG` is on, and the fog.
+    fog_on: bool,
+    fog: Fog,
+    /// `GL_BLEND` is on; the blend function is (source alpha, one minus
+    /// source alpha).
+    blend_on: bool,
+    blend_over: bool,
+    /// `GL_CULL_FACE` is on; `glCullFace`.
+    cull_on: bool,
+    cull_face: u32,
+    /// `glPolygonMode`: front and back.
+    pub(super) polygon_mode: [u32; 2],
     color_material_on: bool,
     color_material: (u32, u32),
     front: MaterialState,
@@ -111,6 +123,13 @@ impl Recorder {
             lit: false,
             flat: false,
             normalize: [false; 2],
+            fog_on: false,
+            fog: Fog::default(),
+            blend_on: false,
+            blend_over: false,
+            polygon_mode: [gl::FILL; 2],
+            cull_on: false,
+            cull_face: gl::BACK,
             color_material_on: false,
             color_material: (gl::FRONT_AND_BACK, gl::AMBIENT_AND_DIFFUSE),
             front: MaterialState::default(),
@@ -164,15 +183,17 @@ impl Recorder {
         View { projection: self.projection(), viewport: self.viewport, depth_test: self.depth_test }
     }
 
-    /// The pass a draw made now goes into (`lit`: the draw is lit): the
-    /// last one, or a new one if the view changed, the depth buffer was
-    /// cleared, or a lit draw sees other lights than the pass's.
-    pub(super) fn draws(&mut self, lit: bool) -> &mut FrameDraws {
+    /// The pass a draw made now goes into (`lit`, `fogged`: the draw is
+    /// lit, fogged): the last one, or a new one if the view changed, the
+    /// depth buffer was cleared, or a lit (fogged) draw sees other lights
+    /// (fog) than the pass's.
+    pub(super) fn draws(&mut self, lit: bool, fogged: bool) -> &mut FrameDraws {
         let view = self.view();
         let split = self.frame.passes.last().is_none_or(|p| {
             p.view != view
                 || self.depth_cleared
                 || (lit && p.draws.lighting.as_ref().is_some_and(|l| *l != self.lighting))
+                || (fogged && p.draws.fog.is_some_and(|f| f != self.fog))
         });
         if split && self.frame.passes.len() >= MAX_PASSES {
             self.counters.passes_merged += 1;
@@ -185,9 +206,13 @@ impl Recorder {
             });
         }
         let lighting = lit.then(|| self.lighting.clone());
+        let fog = self.fog;
         let pass = self.frame.passes.last_mut().expect("a pass was just pushed if none");
         if lighting.is_some() {
             pass.draws.lighting = lighting;
+        }
+        if fogged {
+            pass.draws.fog = Some(fog);
         }
         &mut pass.draws
     }
@@ -275,6 +300,9 @@ impl Recorder {
         Shading {
             lit: self.lit,
             normalize: self.normalize[0] || self.normalize[1],
+            fog: self.fog_on,
+            blend: self.blend_on && self.blend_over,
+            cull: if self.cull_on { self.cull_face } else { 0 },
             flat: self.flat,
             material,
             color_material: self.color_material_on.then_some(self.color_material.1),
@@ -376,6 +404,38 @@ impl Recorder {
                 }
             }
             Command::CallList(id) => self.call_list(id),
+            Command::PolygonMode(face, mode) => {
+                if matches!(mode, gl::POINT | gl::LINE | gl::FILL) {
+                    match face {
+                        gl::FRONT => self.polygon_mode[0] = mode,
+                        gl::BACK => self.polygon_mode[1] = mode,
+                        gl::FRONT_AND_BACK => self.polygon_mode = [mode; 2],
+                        _ => self.counters.ignored += 1,
+                    }
+                } else {
+                    self.counters.ignored += 1;
+                }
+            }
+            Command::Fog(pname, v) => match pname {
+                gl::FOG_MODE if matches!(v.x as u32, gl::LINEAR | gl::EXP | gl::EXP2) => {
+                    self.fog.mode = v.x as u32;
+                }
+                gl::FOG_DENSITY if v.x >= 0.0 => self.fog.density = v.x,
+                gl::FOG_START => self.fog.start = v.x,
+                gl::FOG_END => self.fog.end = v.x,
+                gl::FOG_COLOR => self.fog.color = v.clamp(Vec4::ZERO, Vec4::ONE),
+                _ => self.counters.ignored += 1,
+            },
+            Command::CullFace(face) => match face {
+                gl::FRONT | gl::BACK | gl::FRONT_AND_BACK => self.cull_face = face,
+                _ => self.counters.ignored += 1,
+            },
+            Command::BlendFunc(src, dst) => {
+                self.blend_over = (src, dst) == (gl::SRC_ALPHA, gl::ONE_MINUS_SRC_ALPHA);
+                if !self.blend_over {
+                    self.unsupported("glBlendFunc (other than SRC_ALPHA, ONE_MINUS_SRC_ALPHA)");
+                }
+            }
         }
     }
 
@@ -391,6 +451,9 @@ impl Recorder {
         match cap {
             gl::LIGHTING => self.lit = on,
             gl::NORMALIZE => self.normalize[0] = on,
+            gl::FOG => self.fog_on = on,
+            gl::BLEND => self.blend_on = on,
+            gl::CULL_FACE => self.cull_on = on,
             gl::RESCALE_NORMAL => self.normalize[1] = on,
             gl::DEPTH_TEST => self.depth_test = on,
             gl::SCISSOR_TEST => self.scissor = on,
@@ -440,9 +503,8 @@ fn unsupported_cap(cap: u32) -> Option<&'static str> {
         0x806F => "GL_TEXTURE_3D",
         0x8513 => "GL_TEXTURE_CUBE_MAP",
         0x0C60..=0x0C63 => "GL_TEXTURE_GEN",
-        0x0BE2 => "GL_BLEND",
-        0x0B60 => "GL_FOG",
         0x0BC0 => "GL_ALPHA_TEST",
+        0x0B90 => "GL_STENCIL_TEST",
         0x0B24 => "GL_LINE_STIPPLE",
         0x0B42 => "GL_POLYGON_STIPPLE",
         0x3000..=0x3005 => "GL_CLIP_PLANE",

@@ -14,7 +14,8 @@
  *                       viewport (the window's size) is the one in force.
  *                       With `shadow`, the ball is a display list, drawn
  *                       again flattened onto a floor by a projective
- *                       (planar-shadow) matrix, dark and blended.
+ *                       (planar-shadow) matrix, dark, blended and
+ *                       stencilled.
  *                       With `arrays`, the ball comes from one interleaved
  *                       array (glInterleavedArrays GL_C4F_N3F_V3F, colour
  *                       varying with height, glDrawArrays) beside a panel
@@ -37,6 +38,13 @@
  *                       With `depthclear`, a second, smaller ball behind
  *                       the first drawn after glClear(GL_DEPTH_BUFFER_BIT):
  *                       GL shows it in front.
+ *                       With `fog`, the ball in fog: linear, exp and exp2
+ *                       in turn, frame by frame.
+ *                       With `blend`, two translucent balls (alpha
+ *                       blending, back faces culled, GL_NORMALIZE for
+ *                       their scale) drawn back to front after the ball.
+ *                       With `wireframe`, the ball as its edges
+ *                       (glPolygonMode GL_LINE), unlit.
  *
  * Build: cc -O2 -o private_gl private_gl.c -lX11 -ldl -lm
  */
@@ -181,6 +189,14 @@ int main(int argc, char **argv) {
     int overlay = strcmp(mode, "overlay") == 0;
     int viewports = strcmp(mode, "viewports") == 0;
     int depthclear = strcmp(mode, "depthclear") == 0;
+    int fog = strcmp(mode, "fog") == 0;
+    int blend = strcmp(mode, "blend") == 0;
+    int wireframe = strcmp(mode, "wireframe") == 0;
+    void (*fogi)(GLenum, GLint) = (void *)need("glFogi");
+    void (*fogf)(GLenum, GLfloat) = (void *)need("glFogf");
+    void (*fogfv)(GLenum, const GLfloat *) = (void *)need("glFogfv");
+    void (*polygonMode)(GLenum, GLenum) = (void *)need("glPolygonMode");
+    void (*cullFace)(GLenum) = (void *)need("glCullFace");
 
     if (clockwise) {
         frontFace(GL_CW);
@@ -227,6 +243,62 @@ int main(int argc, char **argv) {
     enable(GL_COLOR_MATERIAL);
     GLfloat pos[4] = {1.0f, 2.0f, 3.0f, 0.0f};
     for (int f = 0; f < frames; f++) {
+        if (fog || blend || wireframe) {
+            clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+            matrixMode(GL_PROJECTION);
+            loadIdentity();
+            frustum(-0.6, 0.6, -0.6, 0.6, 1.0, 20.0);
+            matrixMode(GL_MODELVIEW);
+            loadIdentity();
+            lightfv(GL_LIGHT0, GL_POSITION, pos);
+            translatef(0.0f, 0.0f, -4.0f);
+            rotatef(20.0f * f, 0.3f, 1.0f, 0.0f);
+            if (fog) {
+                const GLfloat grey[4] = {0.5f, 0.5f, 0.55f, 1.0f};
+                const GLint modes[3] = {GL_LINEAR, GL_EXP, GL_EXP2};
+                enable(GL_FOG);
+                fogi(GL_FOG_MODE, modes[f % 3]);
+                fogf(GL_FOG_START, 3.0f);
+                fogf(GL_FOG_END, 5.5f);
+                fogf(GL_FOG_DENSITY, f % 3 == 1 ? 0.3f : 0.25f);
+                fogfv(GL_FOG_COLOR, grey);
+                p_color3f(0.9f, 0.5f, 0.2f);
+                ball();
+                disable(GL_FOG);
+            } else if (blend) {
+                p_color3f(0.9f, 0.5f, 0.2f);
+                ball();
+                enable(GL_BLEND);
+                blendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+                enable(GL_CULL_FACE);
+                cullFace(GL_BACK);
+                enable(GL_NORMALIZE);
+                const float at[2][4] = {{-1.5f, -0.9f, -1.5f, 0.5f}, {0.6f, 0.5f, 1.5f, 0.45f}};
+                for (int k = 0; k < 2; k++) {
+                    pushMatrix();
+                    loadIdentity();
+                    translatef(at[k][0], at[k][1], -4.0f + at[k][2]);
+                    scalef(at[k][3], at[k][3], at[k][3]);
+                    if (k == 0) color4f(0.2f, 0.9f, 0.3f, 0.5f);
+                    else color4f(0.3f, 0.5f, 1.0f, 0.4f);
+                    ball();
+                    popMatrix();
+                }
+                disable(GL_NORMALIZE);
+                disable(GL_CULL_FACE);
+                disable(GL_BLEND);
+            } else {
+                disable(GL_LIGHTING);
+                polygonMode(GL_FRONT_AND_BACK, GL_LINE);
+                p_color3f(0.3f, 0.9f, 0.5f);
+                ball();
+                polygonMode(GL_FRONT_AND_BACK, GL_FILL);
+                enable(GL_LIGHTING);
+            }
+            swapBuffers(dpy, win);
+            finish();
+            continue;
+        }
         if (overlay || viewports || depthclear) {
             /* The views of the frame, whole in themselves. */
             if (overlay) {
@@ -347,9 +419,11 @@ int main(int argc, char **argv) {
             multMatrixf(m);
             disable(GL_LIGHTING);
             enable(GL_BLEND);
+            enable(GL_STENCIL_TEST);
             blendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
             color4f(0.0f, 0.0f, 0.0f, 0.5f);
             callList(1);
+            disable(GL_STENCIL_TEST);
             disable(GL_BLEND);
             enable(GL_LIGHTING);
             popMatrix();
