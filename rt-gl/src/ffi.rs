@@ -241,6 +241,7 @@ intercept! {
     glFogiv(pname: u32, v: *const i32) { if let Some(p) = unsafe { params(pname, v) } { rec(Command::Fog(pname, int_param(pname, p))) } }
     glBlendFunc(src: u32, dst: u32) { rec(Command::BlendFunc(src, dst)) }
     glCullFace(face: u32) { rec(Command::CullFace(face)) }
+    glColorMask(r: u8, g: u8, b: u8, a: u8) { rec(Command::ColorMask(r != 0 || g != 0 || b != 0 || a != 0)) }
     glFrontFace(mode: u32) { rec(Command::FrontFace(mode)) }
     glRectf(x1: f32, y1: f32, x2: f32, y2: f32) { rect(x1, y1, x2, y2) }
     glRectd(x1: f64, y1: f64, x2: f64, y2: f64) { rect(x1 as f32, y1 as f32, x2 as f32, y2 as f32) }

@@ -54,6 +54,7 @@ mod present;
 mod real;
 pub mod record;
 pub mod render;
+mod worker;
 
 use record::Recorder;
 use render::{Illumination, Options};
@@ -69,6 +70,9 @@ pub struct Config {
     pub dump_raster: bool,
     /// `RT_GL_STATS`.
     pub stats: bool,
+    /// `RT_GL_ASYNC`: the program swaps at its own rate; frames are traced
+    /// on a thread of their own and each swap shows the newest traced.
+    pub asynchronous: bool,
     /// `RT_GL_THREADS` (`None`: rayon's global pool, all cores).
     pub pool: Option<rayon::ThreadPool>,
 }
@@ -135,6 +139,7 @@ impl Config {
             dump,
             dump_raster: flag("RT_GL_DUMP_RASTER", false),
             stats: flag("RT_GL_STATS", false),
+            asynchronous: flag("RT_GL_ASYNC", false),
             pool,
         }
     }

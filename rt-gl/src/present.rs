@@ -6,8 +6,9 @@ use core::ffi::c_void;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::{
-    composite::{Content, Layer, composite, keeps_raster},
+    composite::{Content, Layer, composite, keeps_raster, needs_raster},
     config, gl, log_once, real,
+    record::{Counters, Lighting, Pass},
     render::{FrameScene, Image},
     with_recorder,
 };
@@ -32,7 +33,68 @@ pub(crate) fn single_buffered_frame() {
 
 fn present_frame(buffer: u32) {
     let cfg = config();
-    let taken = with_recorder(|r| {
+    let Some(taken) = take(buffer) else {
+        return;
+    };
+    if cfg.asynchronous {
+        let n = taken.n;
+        let (counters, unsupported) = (taken.counters, taken.unsupported.clone());
+        crate::worker::submit(taken);
+        match crate::worker::latest() {
+            Some(traced) => show(buffer, &traced, n, &counters, &unsupported),
+            None => {
+                if let Some(dir) = &cfg.dump {
+                    write_counters(dir, &counters, &[], &unsupported);
+                }
+            }
+        }
+    } else {
+        let traced = trace(&taken, 0);
+        show(buffer, &traced, taken.n, &taken.counters, &taken.unsupported);
+    }
+}
+
+/// A frame taken from the recorder at its swap: everything tracing it
+/// needs, no GL; traced on the program's thread or, with `RT_GL_ASYNC`,
+/// on the worker's.
+pub(crate) struct Taken {
+    /// The frame's number.
+    pub(crate) n: u64,
+    /// The window rectangle its passes cover.
+    pub(crate) window: [i32; 4],
+    /// Each pass with its viewport resolved.
+    pub(crate) passes: Vec<([i32; 4], Pass)>,
+    /// The lights at the swap, for passes with no lit draw.
+    pub(crate) lighting: Lighting,
+    /// GL's pixels over `window`, read back at the swap when a pass may
+    /// be blended over them (see [`crate::composite::needs_raster`]).
+    raster: Option<Image>,
+    counters: Counters,
+    unsupported: Vec<(&'static str, u64)>,
+}
+
+/// A traced frame, ready to draw over GL's.
+pub(crate) struct Traced {
+    /// The number of the frame it shows.
+    pub(crate) n: u64,
+    /// Where it goes in the window.
+    pub(crate) window: [i32; 4],
+    /// The composite (alpha 0: GL's pixel stays).
+    pub(crate) image: Image,
+    /// Instances left out; passes traced; passes kept as GL drew them.
+    pub(crate) left_out: usize,
+    pub(crate) traced: usize,
+    pub(crate) kept: usize,
+    /// Progressive passes averaged into `image`.
+    pub(crate) samples: u32,
+}
+
+/// Ends the recorder's frame: its passes with their viewports resolved,
+/// the unsupported features reported, GL's raster dumped. `None`: nothing
+/// to trace.
+fn take(buffer: u32) -> Option<Taken> {
+    let cfg = config();
+    let (frame, lighting, counters, unsupported) = with_recorder(|r| {
         if r.compiling_only() {
             return None;
         }
@@ -41,10 +103,7 @@ fn present_frame(buffer: u32) {
             r.unsupported.iter().map(|(k, v)| (*k, *v)).collect();
         Some((frame, r.lighting.clone(), r.counters, unsupported))
     })
-    .flatten();
-    let Some((frame, lighting, counters, unsupported)) = taken else {
-        return;
-    };
+    .flatten()?;
     for (what, _) in &unsupported {
         log_once(
             &format!("unsupported {what}"),
@@ -66,28 +125,53 @@ fn present_frame(buffer: u32) {
         .map(|p| (resolve(p.view.viewport), p))
         .filter(|(v, _)| v[2] > 0 && v[3] > 0)
         .collect();
-    let Some(window) = passes.iter().map(|(v, _)| *v).reduce(union) else {
-        return;
-    };
-    let window = clip_to_window(window);
+    let window = clip_to_window(passes.iter().map(|(v, _)| *v).reduce(union)?);
     if window[2] <= 0 || window[3] <= 0 {
-        return;
+        return None;
     }
-    if let (true, Some(dir)) = (cfg.dump_raster, &cfg.dump) {
-        let img = read_back(buffer, window);
-        if let Err(e) = img.write_png(&dir.join(format!("raster-{n:04}.png"))) {
-            log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
+    // Blended draws after a 2-D overlay: GL's pixels may be needed under them.
+    let blended_after_overlay =
+        passes.iter().skip_while(|(v, p)| !p.view.is_kept(*v)).any(|(_, p)| pass_blends(p));
+    let dump_raster = cfg.dump_raster && cfg.dump.is_some();
+    let raster = (dump_raster || blended_after_overlay).then(|| read_back(buffer, window));
+    if let (true, Some(dir), Some(img)) = (dump_raster, &cfg.dump, &raster)
+        && let Err(e) = img.write_png(&dir.join(format!("raster-{n:04}.png")))
+    {
+        log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
+    }
+    if std::env::var("RT_GL_DEBUG_PASSES").is_ok() {
+        for (v, p) in &passes {
+            eprintln!(
+                "frame {n} pass vp={v:?} overlay={} depth={} cleared={} tris={} inst={} lit={} p={:?}",
+                p.view.is_kept(*v),
+                p.view.depth_test,
+                p.depth_cleared,
+                p.draws.immediate.triangles.len(),
+                p.draws.instances.len(),
+                p.draws.lighting.is_some(),
+                p.view.projection.to_cols_array()
+            );
         }
     }
+    Some(Taken { n, window, passes, lighting, raster, counters, unsupported })
+}
+
+/// Traces each pass of `taken` (progressive pass `sample`) and composites
+/// them. No GL: any thread.
+pub(crate) fn trace(taken: &Taken, sample: u32) -> Traced {
+    let cfg = config();
+    let n = taken.n;
     let mut left_out = 0;
     let mut traced = 0;
-    let layers: Vec<Layer> = passes
-        .into_iter()
+    let layers: Vec<Layer> = taken
+        .passes
+        .iter()
         .map(|(viewport, pass)| {
-            let overlay = pass.view.is_overlay(viewport);
+            let viewport = *viewport;
+            let overlay = pass.view.is_kept(viewport);
             let content = crate::catch(|| {
-                let pass_lighting = pass.draws.lighting.clone().unwrap_or_else(|| lighting.clone());
-                let scene = FrameScene::build(pass.draws)?;
+                let lighting = pass.draws.lighting.as_ref().unwrap_or(&taken.lighting);
+                let scene = FrameScene::build(pass.draws.clone())?;
                 left_out += scene.left_out();
                 let [_, _, w, h] = viewport.map(|v| v as u32);
                 let projection = pass.view.projection;
@@ -96,13 +180,14 @@ fn present_frame(buffer: u32) {
                         scene.coverage(projection, w, h).map(|depth| Content::Raster { depth })
                     } else {
                         scene
-                            .render_with_depth(
-                                &pass_lighting,
+                            .render_sample(
+                                lighting,
                                 projection,
                                 w,
                                 h,
                                 pass.background,
                                 &cfg.options,
+                                sample,
                             )
                             .map(|(image, depth)| Content::Traced { image, depth })
                     }
@@ -142,28 +227,64 @@ fn present_frame(buffer: u32) {
             ),
         );
     }
+    let kept = layers.len() - traced;
+    // Nothing traced: an empty composite, the frame stays as GL drew it.
+    let image = if traced == 0 {
+        Image { width: 0, height: 0, rgba: Vec::new() }
+    } else {
+        composite(taken.window, &layers, taken.raster.as_ref().filter(|_| needs_raster(&layers)))
+    };
+    Traced { n, window: taken.window, image, left_out, traced, kept, samples: 1 }
+}
+
+/// Draws `traced` over GL's frame `n`, dumps what the window shows, writes
+/// the counters.
+fn show(
+    buffer: u32,
+    traced: &Traced,
+    n: u64,
+    counters: &Counters,
+    unsupported: &[(&'static str, u64)],
+) {
+    let cfg = config();
     if let Some(dir) = &cfg.dump {
-        let passes = [("traced", traced), ("kept", layers.len() - traced)];
-        write_counters(dir, &counters, left_out, &passes, &unsupported);
+        let mut extra = vec![
+            ("left_out", traced.left_out as u64),
+            ("passes.traced", traced.traced as u64),
+            ("passes.kept", traced.kept as u64),
+        ];
+        if cfg.asynchronous {
+            extra.extend([("async.frame", traced.n), ("async.samples", u64::from(traced.samples))]);
+        }
+        write_counters(dir, counters, &extra, unsupported);
     }
-    if traced == 0 {
-        // Nothing traced: the frame stays exactly as GL drew it.
+    if traced.traced == 0 {
         return;
     }
-    let img = composite(window, &layers);
-    let keep = keeps_raster(&img);
+    let img = &traced.image;
+    let keep = keeps_raster(img);
     // SAFETY: `img` holds w·h RGBA pixels; the state touched is restored.
-    unsafe { draw(&img, window[0], window[1], keep) };
+    unsafe { draw(img, traced.window[0], traced.window[1], keep) };
     if let Some(dir) = &cfg.dump {
         // What the window shows: GL's overlays read back where kept.
-        let shown = if keep { read_back(buffer, window) } else { img };
+        let shown = if keep { &read_back(buffer, traced.window) } else { img };
         if let Err(e) = shown.write_png(&dir.join(format!("rt-{n:04}.png"))) {
             log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
         }
     }
     if cfg.stats {
-        eprintln!("rt-gl: frame {n}: {:?}", counters);
+        eprintln!("rt-gl: frame {n}: {counters:?}");
     }
+}
+
+/// Whether any of `p`'s draws is blended.
+fn pass_blends(p: &Pass) -> bool {
+    let d = &p.draws;
+    d.immediate.shadings.iter().any(|s| s.blend)
+        || d.instances.iter().any(|i| match &i.paint {
+            Some(paint) => paint.shading.blend,
+            None => i.recorded.geometry().shadings.iter().any(|s| s.blend),
+        })
 }
 
 /// The smallest rectangle holding `a` and `b` (`[x, y, width, height]`).
@@ -183,19 +304,19 @@ fn clip_to_window([x, y, w, h]: [i32; 4]) -> [i32; 4] {
     [x0, y0, w, h]
 }
 
-/// `counters.txt` in `dir`: the recorder's counters, the instances left
-/// out of the last frame, its passes traced and kept as GL drew them
-/// (`passes.traced`, `passes.kept`) and each unsupported feature's count
-/// (`unsupported.NAME=count`).
+/// `counters.txt` in `dir`: the recorder's counters, then `extra` (the
+/// instances left out of the frame shown, its passes traced and kept as
+/// GL drew them, and with `RT_GL_ASYNC` which frame it is and how many
+/// progressive passes it averages), then each unsupported feature's
+/// count (`unsupported.NAME=count`).
 fn write_counters(
     dir: &std::path::Path,
-    c: &crate::record::Counters,
-    left_out: usize,
-    passes: &[(&str, usize)],
+    c: &Counters,
+    extra: &[(&str, u64)],
     unsupported: &[(&'static str, u64)],
 ) {
     let mut line = format!(
-        "frames={} passes={} passes_merged={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_refits={} draw_inline={} instances={} triangles={} ignored={} left_out={left_out}",
+        "frames={} passes={} passes_merged={} list_builds={} list_reuses={} list_inline={} draw_builds={} draw_reuses={} draw_refits={} draw_inline={} instances={} triangles={} ignored={}",
         c.frames,
         c.passes,
         c.passes_merged,
@@ -210,8 +331,8 @@ fn write_counters(
         c.triangles,
         c.ignored
     );
-    for (what, count) in passes {
-        line += &format!(" passes.{what}={count}");
+    for (what, count) in extra {
+        line += &format!(" {what}={count}");
     }
     for (what, count) in unsupported {
         line += &format!(" unsupported.{what}={count}");

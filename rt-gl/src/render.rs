@@ -349,10 +349,44 @@ impl FrameScene {
         background: Vec4,
         opts: &Options,
     ) -> Result<(Image, Vec<f32>), RenderError> {
+        let (mut image, depth) =
+            self.render_sample(lighting, projection, width, height, background, opts, 0)?;
+        // Over the background: what blended surfaces and misses let through.
+        let bg = background.clamp(Vec4::ZERO, Vec4::ONE) * 255.0;
+        for px in image.rgba.chunks_exact_mut(4) {
+            let through = 1.0 - f32::from(px[3]) / 255.0;
+            for (k, c) in px.iter_mut().enumerate() {
+                *c = (f32::from(*c) + through * bg[k]).round().min(255.0) as u8;
+            }
+        }
+        Ok((image, depth))
+    }
+
+    /// The frame's own colours, not over a background: premultiplied by
+    /// their opacity (alpha: 1 where an opaque surface is hit, less where
+    /// only blended ones are, 0 where nothing is), to be put over what
+    /// lies behind (an earlier pass); and with the random directions
+    /// (ambient occlusion) of pass `sample`: passes 0, 1, 2, … of one
+    /// scene average to a less noisy image.
+    /// [`FrameScene::render_with_depth`] is pass 0 over the background.
+    ///
+    /// # Errors
+    /// As [`FrameScene::render`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_sample(
+        &self,
+        lighting: &Lighting,
+        projection: Mat4,
+        width: u32,
+        height: u32,
+        background: Vec4,
+        opts: &Options,
+        sample: u32,
+    ) -> Result<(Image, Vec<f32>), RenderError> {
         if !opts.is_valid() {
             return Err(RenderError::BadOptions);
         }
-        let shade = Shade { lighting, opts, background };
+        let shade = Shade { lighting, opts, background, sample };
         let (rgba, depth) = self.trace(projection, width, height, Some(&shade))?;
         Ok((Image { width, height, rgba }, depth))
     }
@@ -388,7 +422,6 @@ impl FrameScene {
         if projection.determinant() == 0.0 || !inv.is_finite() {
             return Err(RenderError::BadProjection);
         }
-        let bg = shade.map(|s| to_rgba8(s.background));
         let (w, n) = (width as usize, width as usize * height as usize);
         let mut rgba = vec![0u8; if shade.is_some() { 4 * n } else { 0 }];
         let mut depth = vec![f32::INFINITY; n];
@@ -406,10 +439,11 @@ impl FrameScene {
                 let ndc_z = projection.project_point3(h.position).z;
                 *z = if ndc_z.is_finite() { (0.5 * ndc_z + 0.5).clamp(0.0, 1.0) } else { 0.0 };
             }
-            if let (Some(px), Some(s), Some(bg)) = (px, shade, bg) {
+            if let (Some(px), Some(s)) = (px, shade) {
                 let c = match hit {
                     Some(first) => {
-                        let seed = (y as u64) << 32 | x as u64;
+                        let seed = ((y as u64) << 32 | x as u64)
+                            ^ u64::from(s.sample).wrapping_mul(0xd1b5_4a32_d192_ed03);
                         let ctx = ShadeCtx {
                             lighting: s.lighting,
                             opts: s.opts,
@@ -418,7 +452,8 @@ impl FrameScene {
                         };
                         to_rgba8(self.shade_through(&ray, first, &ctx))
                     }
-                    None => bg,
+                    // Nothing: transparent, for what lies behind to show.
+                    None => [0; 4],
                 };
                 px.copy_from_slice(&c);
             }
@@ -534,7 +569,8 @@ impl FrameScene {
     }
 
     /// Front to back through blended surfaces, each over what lies behind
-    /// it (at most [`MAX_LAYERS`] of them; the background behind the last).
+    /// it (at most [`MAX_LAYERS`] of them): the colour premultiplied, and
+    /// the opacity (what lies behind shows through `1 −` it).
     /// Sorted by depth whatever order they were drawn in: GL's image of
     /// the same surfaces drawn back to front.
     fn shade_through(&self, ray: &Ray, first: (Source, Hit), ctx: &ShadeCtx<'_>) -> Vec4 {
@@ -556,7 +592,7 @@ impl FrameScene {
             r = on;
             next = self.closest(&r);
         }
-        (acc + through * ctx.background.truncate()).extend(1.0)
+        acc.extend(1.0 - through)
     }
 
     /// GL's lighting equation at `hit`, per pixel.
@@ -682,6 +718,8 @@ struct Shade<'a> {
     lighting: &'a Lighting,
     opts: &'a Options,
     background: Vec4,
+    /// The progressive pass (seeds the random directions).
+    sample: u32,
 }
 
 /// What every shading call of one frame shares.

@@ -81,6 +81,16 @@ fn program(dir: &Path, name: &str, libs: &[&str]) -> PathBuf {
 /// into `dir` (and Mesa's raster of each); `(stdout, stderr)` of a run
 /// that must succeed.
 fn run_traced(exe: &Path, args: &[&str], dir: &Path) -> (String, String) {
+    run_traced_with(exe, args, dir, &[])
+}
+
+/// [`run_traced`] with more environment variables.
+fn run_traced_with(
+    exe: &Path,
+    args: &[&str],
+    dir: &Path,
+    vars: &[(&str, &str)],
+) -> (String, String) {
     let out = Command::new(tool("xvfb-run"))
         .args(["-a", "-s", "-screen 0 640x480x24"])
         .arg(exe)
@@ -88,6 +98,7 @@ fn run_traced(exe: &Path, args: &[&str], dir: &Path) -> (String, String) {
         .env("LD_PRELOAD", interposer())
         .env("RT_GL_DUMP", dir)
         .env("RT_GL_DUMP_RASTER", "1")
+        .envs(vars.iter().copied())
         .output()
         .expect("run xvfb-run");
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
@@ -388,6 +399,35 @@ fn blended_translucent_balls_are_seen_through() {
 #[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
 fn polygon_mode_lines_are_traced_as_lines() {
     private_gl_frames_match_the_raster("wireframe", &["wireframe"]);
+}
+
+/// `RT_GL_ASYNC=1` on a still ball in `rt` mode (shadows, 4 AO rays):
+/// the program swaps at its own rate, each swap showing the newest frame
+/// the worker traced, and while the scene stays still the worker averages
+/// further passes (`async.samples` > 1 by the end); the frames shown
+/// cover what Mesa's do.
+#[test]
+#[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
+fn asynchronous_frames_grow_less_noisy_on_a_still_scene() {
+    let dir = scratch("async");
+    let exe = program(&dir, "private_gl", &["-lX11", "-ldl", "-lm"]);
+    let vars = [("RT_GL_ASYNC", "1"), ("RT_GL_MODE", "rt"), ("RT_GL_AO", "4")];
+    let (stdout, stderr) = run_traced_with(&exe, &["200", "still"], &dir, &vars);
+    assert!(stdout.contains("frames 200"), "{stdout}");
+    let c = counters(&dir);
+    assert!(c["async.samples"] > 1, "{c:?}\n{stderr}");
+    let shown: Vec<usize> =
+        (0..200).filter(|f| dir.join(format!("rt-{f:04}.png")).exists()).collect();
+    assert!(shown.len() > 100, "{} of 200 frames showed a traced one", shown.len());
+    for &f in shown.iter().rev().take(3) {
+        let (agree, _) = compare(
+            &dir.join(format!("raster-{f:04}.png")),
+            &dir.join(format!("rt-{f:04}.png")),
+            [26, 26, 38],
+        );
+        assert!(agree >= 0.99, "frame {f}: coverage agrees on {:.2} %", 100.0 * agree);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Runs the private-GL program with `args` after the frame count; every

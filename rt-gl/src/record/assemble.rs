@@ -53,6 +53,10 @@ impl Recorder {
 
     /// Turns one `glBegin`/`glEnd` into triangles, spheres or tubes.
     pub(super) fn assemble(&mut self, mode: u32, verts: &[Vert]) {
+        if !self.color_write {
+            // A depth-only pass: nothing of it is seen.
+            return;
+        }
         // `glPolygonMode`: polygons drawn as their edges or corners (the
         // front faces' mode; back faces are taken the same).
         let polygon = (gl::TRIANGLES..=gl::POLYGON).contains(&mode);

@@ -15,6 +15,8 @@ pub(super) struct Inherited {
     pub(super) shading: Shading,
     /// Clockwise front faces (`glFrontFace(GL_CW)`).
     pub(super) front_cw: bool,
+    /// Colour written (`glColorMask`).
+    pub(super) color_write: bool,
     /// Definitions seen (lists that call others).
     generation: u64,
 }
@@ -38,6 +40,7 @@ impl Recorder {
             normal: self.normal,
             shading: self.shading(),
             front_cw: self.front_cw,
+            color_write: self.color_write,
             generation,
         }
     }
@@ -93,7 +96,7 @@ impl Recorder {
 
     /// Adds an instance of cached geometry to the frame.
     pub(super) fn instance(&mut self, recorded: Arc<Recorded>, mv: Mat4, paint: Option<Paint>) {
-        if !recorded.geometry().is_empty() && self.state_only == 0 {
+        if !recorded.geometry().is_empty() && self.state_only == 0 && self.color_write {
             let shadings = recorded.geometry().shadings.iter();
             let (lit, fogged) = match &paint {
                 Some(p) => (p.shading.lit, p.shading.fog),

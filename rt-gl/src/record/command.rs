@@ -59,4 +59,7 @@ pub enum Command {
     BlendFunc(u32, u32),
     /// `glCullFace(face)`.
     CullFace(u32),
+    /// `glColorMask`: whether any colour channel is written (a depth-only
+    /// pass writes none).
+    ColorMask(bool),
 }

@@ -117,6 +117,9 @@ pub struct View {
     pub viewport: [i32; 4],
     /// `GL_DEPTH_TEST` was on.
     pub depth_test: bool,
+    /// A texture target was enabled: the trace has no textures, so the
+    /// pass's pixels are GL's own (see [`View::is_kept`]).
+    pub textured: bool,
 }
 
 impl View {
@@ -126,6 +129,17 @@ impl View {
     /// in force, resolved when the pass's own was never set).
     #[must_use]
     pub fn is_overlay(&self, viewport: [i32; 4]) -> bool {
+        self.is_2d(viewport)
+    }
+
+    /// Whether the pass is shown as GL drew it where it covers, not
+    /// traced: a 2-D overlay ([`View::is_overlay`]) or a textured pass.
+    #[must_use]
+    pub fn is_kept(&self, viewport: [i32; 4]) -> bool {
+        self.textured || self.is_2d(viewport)
+    }
+
+    fn is_2d(&self, viewport: [i32; 4]) -> bool {
         let p = &self.projection;
         let orthographic = p.row(3) == Vec4::W;
         // One unit per pixel, within 2 % (gluOrtho2D(0, w, 0, h) and its

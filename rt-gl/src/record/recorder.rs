@@ -50,6 +50,9 @@ pub struct Recorder {
     /// `GL_CULL_FACE` is on; `glCullFace`.
     cull_on: bool,
     cull_face: u32,
+    /// `glColorMask`: some channel is written. Draws made with none are
+    /// depth-only passes, not seen: they are not recorded.
+    pub(super) color_write: bool,
     /// `glPolygonMode`: front and back.
     pub(super) polygon_mode: [u32; 2],
     color_material_on: bool,
@@ -77,6 +80,10 @@ pub struct Recorder {
     pub(super) frame: Frame,
     /// `GL_DEPTH_TEST` is on.
     depth_test: bool,
+    /// Which texture targets are on (a bit each).
+    texture_targets: u8,
+    /// A texture target (`GL_TEXTURE_1D`, `_2D`, `_3D`, `_CUBE_MAP`) is on.
+    textured: bool,
     /// `GL_SCISSOR_TEST` is on (a colour clear then clears a rectangle,
     /// not the frame).
     scissor: bool,
@@ -129,6 +136,7 @@ impl Recorder {
             blend_over: false,
             polygon_mode: [gl::FILL; 2],
             cull_on: false,
+            color_write: true,
             cull_face: gl::BACK,
             color_material_on: false,
             color_material: (gl::FRONT_AND_BACK, gl::AMBIENT_AND_DIFFUSE),
@@ -147,6 +155,8 @@ impl Recorder {
             cache: HashMap::new(),
             frame: Frame::default(),
             depth_test: false,
+            textured: false,
+            texture_targets: 0,
             scissor: false,
             background: Vec4::ZERO,
             depth_cleared: false,
@@ -180,7 +190,12 @@ impl Recorder {
     /// What a draw made now is made under.
     #[must_use]
     pub fn view(&self) -> View {
-        View { projection: self.projection(), viewport: self.viewport, depth_test: self.depth_test }
+        View {
+            projection: self.projection(),
+            viewport: self.viewport,
+            depth_test: self.depth_test,
+            textured: self.textured,
+        }
     }
 
     /// The pass a draw made now goes into (`lit`, `fogged`: the draw is
@@ -426,6 +441,7 @@ impl Recorder {
                 gl::FOG_COLOR => self.fog.color = v.clamp(Vec4::ZERO, Vec4::ONE),
                 _ => self.counters.ignored += 1,
             },
+            Command::ColorMask(any) => self.color_write = any,
             Command::CullFace(face) => match face {
                 gl::FRONT | gl::BACK | gl::FRONT_AND_BACK => self.cull_face = face,
                 _ => self.counters.ignored += 1,
@@ -456,6 +472,18 @@ impl Recorder {
             gl::CULL_FACE => self.cull_on = on,
             gl::RESCALE_NORMAL => self.normalize[1] = on,
             gl::DEPTH_TEST => self.depth_test = on,
+            // One texture unit's targets: any on makes draws textured.
+            0x0DE0 | 0x0DE1 | 0x806F | 0x8513 => {
+                let bit = match cap {
+                    0x0DE0 => 1,
+                    0x0DE1 => 2,
+                    0x806F => 4,
+                    _ => 8,
+                };
+                self.texture_targets =
+                    if on { self.texture_targets | bit } else { self.texture_targets & !bit };
+                self.textured = self.texture_targets != 0;
+            }
             gl::SCISSOR_TEST => self.scissor = on,
             gl::COLOR_MATERIAL => {
                 self.color_material_on = on;

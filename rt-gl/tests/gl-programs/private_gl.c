@@ -45,6 +45,7 @@
  *                       their scale) drawn back to front after the ball.
  *                       With `wireframe`, the ball as its edges
  *                       (glPolygonMode GL_LINE), unlit.
+ *                       With `still`, the ball does not turn.
  *
  * Build: cc -O2 -o private_gl private_gl.c -lX11 -ldl -lm
  */
@@ -192,6 +193,7 @@ int main(int argc, char **argv) {
     int fog = strcmp(mode, "fog") == 0;
     int blend = strcmp(mode, "blend") == 0;
     int wireframe = strcmp(mode, "wireframe") == 0;
+    int still = strcmp(mode, "still") == 0;
     void (*fogi)(GLenum, GLint) = (void *)need("glFogi");
     void (*fogf)(GLenum, GLfloat) = (void *)need("glFogf");
     void (*fogfv)(GLenum, const GLfloat *) = (void *)need("glFogfv");
@@ -406,7 +408,7 @@ int main(int argc, char **argv) {
         loadIdentity();
         lightfv(GL_LIGHT0, GL_POSITION, pos);
         translatef(0.0f, 0.0f, -4.0f);
-        rotatef(20.0f * f, 0.3f, 1.0f, 0.0f);
+        rotatef(still ? 0.0f : 20.0f * f, 0.3f, 1.0f, 0.0f);
         p_color3f(0.9f, 0.5f, 0.2f);
         if (shadow) {
             callList(1);
