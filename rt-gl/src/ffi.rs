@@ -20,7 +20,7 @@ use glam::{Mat4, Vec3, Vec4};
 use crate::{
     gl,
     real::RealFn,
-    record::{Command, arrays, frustum, ortho, rotate, scale, translate},
+    record::{Command, Recorder, arrays, frustum, ortho, rotate, scale, translate},
     with_recorder,
 };
 
@@ -162,6 +162,90 @@ fn rect(x1: f32, y1: f32, x2: f32, y2: f32) {
     }
 }
 
+/// `glTexEnv*v` parameters: four for the colour, one otherwise.
+///
+/// # Safety
+/// `p` is null or points to as many values as `pname` takes.
+unsafe fn tex_env_params<T: Copy + Into<f64>>(pname: u32, p: *const T) -> Option<Vec4> {
+    if p.is_null() {
+        return None;
+    }
+    let n = if pname == gl::TEXTURE_ENV_COLOR { 4 } else { 1 };
+    let mut v = [0.0f32; 4];
+    for (i, x) in v.iter_mut().enumerate().take(n) {
+        // SAFETY: the caller guarantees `n` readable values.
+        *x = unsafe { (*p.add(i)).into() } as f32;
+    }
+    Some(Vec4::from_array(v))
+}
+
+/// The client image a `glTex(Sub)Image2D` call points at, if it can be
+/// read: not null, not an offset into a pixel buffer object, of a layout
+/// whose size is known.
+///
+/// # Safety
+/// GL requires `data`, if not null and no unpack buffer is bound, to
+/// hold the image as the unpack state lays it out.
+unsafe fn client_image<'a>(
+    r: &Recorder,
+    [w, h]: [i32; 2],
+    format: u32,
+    ty: u32,
+    data: *const c_void,
+) -> Option<&'a [u8]> {
+    if data.is_null() || r.unpacks_from_buffer() {
+        return None;
+    }
+    let n = r.unpack.image_bytes(usize::try_from(w).ok()?, usize::try_from(h).ok()?, format, ty)?;
+    // SAFETY: as the caller guarantees.
+    Some(unsafe { core::slice::from_raw_parts(data.cast::<u8>(), n) })
+}
+
+fn tex_image(
+    target: u32,
+    level: i32,
+    internal: u32,
+    size: [i32; 2],
+    format: u32,
+    ty: u32,
+    data: *const c_void,
+) {
+    with_recorder(|r| {
+        // SAFETY: the program's own image, as GL reads it.
+        let image = unsafe { client_image(r, size, format, ty, data) };
+        // Null data is an image left undefined; anything else unread is
+        // an image not known.
+        let image = if data.is_null() { None } else { Some(image.unwrap_or(&[])) };
+        r.tex_image_2d(target, level, internal, size, format, ty, image);
+    });
+}
+
+fn tex_sub_image(
+    target: u32,
+    level: i32,
+    at: [i32; 2],
+    size: [i32; 2],
+    format: u32,
+    ty: u32,
+    data: *const c_void,
+) {
+    with_recorder(|r| {
+        // SAFETY: the program's own image, as GL reads it.
+        let image = unsafe { client_image(r, size, format, ty, data) };
+        r.tex_sub_image_2d(target, level, at, size, format, ty, image);
+    });
+}
+
+fn delete_textures(n: i32, names: *const u32) {
+    let Ok(n) = usize::try_from(n) else { return };
+    if names.is_null() {
+        return;
+    }
+    // SAFETY: GL requires `names` to hold `n` names.
+    let names = unsafe { core::slice::from_raw_parts(names, n) };
+    with_recorder(|r| r.delete_textures(names));
+}
+
 /// Notes a call the trace does not honour (reported at the next frame).
 fn unsupported(what: &'static str) {
     with_recorder(|r| r.unsupported(what));
@@ -250,6 +334,38 @@ intercept! {
     glRectfv(a: *const f32, b: *const f32) { if let (Some([x1, y1]), Some([x2, y2])) = unsafe { (read(a), read(b)) } { rect(x1, y1, x2, y2) } }
     glRectdv(a: *const f64, b: *const f64) { if let (Some([x1, y1]), Some([x2, y2])) = unsafe { (read(a), read(b)) } { rect(x1 as f32, y1 as f32, x2 as f32, y2 as f32) } }
     glInterleavedArrays(format: u32, stride: i32, p: *const c_void) { with_recorder(|r| r.interleaved_arrays(format, stride, p as usize)); }
+    glTexCoord1f(s: f32) { rec(Command::TexCoord(Vec4::new(s, 0.0, 0.0, 1.0))) }
+    glTexCoord1d(s: f64) { rec(Command::TexCoord(Vec4::new(s as f32, 0.0, 0.0, 1.0))) }
+    glTexCoord2f(s: f32, t: f32) { rec(Command::TexCoord(Vec4::new(s, t, 0.0, 1.0))) }
+    glTexCoord2d(s: f64, t: f64) { rec(Command::TexCoord(Vec4::new(s as f32, t as f32, 0.0, 1.0))) }
+    glTexCoord2i(s: i32, t: i32) { rec(Command::TexCoord(Vec4::new(s as f32, t as f32, 0.0, 1.0))) }
+    glTexCoord2s(s: i16, t: i16) { rec(Command::TexCoord(Vec4::new(s.into(), t.into(), 0.0, 1.0))) }
+    glTexCoord3f(s: f32, t: f32, r: f32) { rec(Command::TexCoord(Vec4::new(s, t, r, 1.0))) }
+    glTexCoord4f(s: f32, t: f32, r: f32, q: f32) { rec(Command::TexCoord(Vec4::new(s, t, r, q))) }
+    glTexCoord2fv(v: *const f32) { if let Some([s, t]) = unsafe { read(v) } { rec(Command::TexCoord(Vec4::new(s, t, 0.0, 1.0))) } }
+    glTexCoord2dv(v: *const f64) { if let Some([s, t]) = unsafe { read(v) } { rec(Command::TexCoord(Vec4::new(s as f32, t as f32, 0.0, 1.0))) } }
+    glTexCoord3fv(v: *const f32) { if let Some([s, t, r]) = unsafe { read(v) } { rec(Command::TexCoord(Vec4::new(s, t, r, 1.0))) } }
+    glTexCoord4fv(v: *const f32) { if let Some(c) = unsafe { read(v) } { rec(Command::TexCoord(Vec4::from_array(c))) } }
+    glMultiTexCoord2f(unit: u32, s: f32, t: f32) { if unit == 0x84C0 { rec(Command::TexCoord(Vec4::new(s, t, 0.0, 1.0))) } }
+    glMultiTexCoord2fv(unit: u32, v: *const f32) { if let (0x84C0, Some([s, t])) = (unit, unsafe { read(v) }) { rec(Command::TexCoord(Vec4::new(s, t, 0.0, 1.0))) } }
+    glTexCoordPointer(size: i32, ty: u32, stride: i32, p: *const c_void) { with_recorder(|r| r.pointer(arrays::TEXTURE_COORD_ARRAY, size, ty, stride, p as usize)); }
+    glBindTexture(target: u32, name: u32) { rec(Command::BindTexture(target, name)) }
+    glDeleteTextures(n: i32, names: *const u32) { delete_textures(n, names) }
+    glActiveTexture(unit: u32) { with_recorder(|r| r.active_texture(unit)); }
+    glActiveTextureARB(unit: u32) { with_recorder(|r| r.active_texture(unit)); }
+    glTexImage2D(target: u32, level: i32, internal: i32, w: i32, h: i32, border: i32, format: u32, ty: u32, data: *const c_void) { let _ = border; tex_image(target, level, internal as u32, [w, h], format, ty, data) }
+    glTexSubImage2D(target: u32, level: i32, x: i32, y: i32, w: i32, h: i32, format: u32, ty: u32, data: *const c_void) { tex_sub_image(target, level, [x, y], [w, h], format, ty, data) }
+    glTexParameteri(target: u32, pname: u32, v: i32) { with_recorder(|r| r.tex_parameter(target, pname, v as f32)); }
+    glTexParameterf(target: u32, pname: u32, v: f32) { with_recorder(|r| r.tex_parameter(target, pname, v)); }
+    glTexParameteriv(target: u32, pname: u32, v: *const i32) { if let Some([x]) = unsafe { read(v) } { with_recorder(|r| r.tex_parameter(target, pname, x as f32)); } }
+    glTexParameterfv(target: u32, pname: u32, v: *const f32) { if let Some([x]) = unsafe { read(v) } { with_recorder(|r| r.tex_parameter(target, pname, x)); } }
+    glTexEnvi(target: u32, pname: u32, v: i32) { if target == 0x2300 { rec(Command::TexEnv(pname, Vec4::new(v as f32, 0.0, 0.0, 0.0))) } }
+    glTexEnvf(target: u32, pname: u32, v: f32) { if target == 0x2300 { rec(Command::TexEnv(pname, Vec4::new(v, 0.0, 0.0, 0.0))) } }
+    glTexEnvfv(target: u32, pname: u32, v: *const f32) { if target == 0x2300 && let Some(p) = unsafe { tex_env_params(pname, v) } { rec(Command::TexEnv(pname, p)) } }
+    glTexEnviv(target: u32, pname: u32, v: *const i32) { if target == 0x2300 && let Some(p) = unsafe { tex_env_params(pname, v) } { rec(Command::TexEnv(pname, if pname == gl::TEXTURE_ENV_COLOR { p / 2_147_483_647.0 } else { p })) } }
+    glPixelStorei(pname: u32, v: i32) { with_recorder(|r| r.pixel_store(pname, v)); }
+    glAlphaFunc(func: u32, reference: f32) { rec(Command::AlphaFunc(func, reference)) }
+    glDepthFunc(func: u32) { rec(Command::DepthFunc(func)) }
     glBitmap(w: i32, h: i32, xo: f32, yo: f32, xm: f32, ym: f32, b: *const u8) { let _ = (w, h, xo, yo, xm, ym, b); unsupported("glBitmap") }
     glDrawPixels(w: i32, h: i32, format: u32, ty: u32, data: *const c_void) { let _ = (w, h, format, ty, data); unsupported("glDrawPixels") }
     glUseProgram(program: u32) { if program != 0 { unsupported("glUseProgram") } }

@@ -65,6 +65,28 @@ pub const FLOAT: u32 = 0x1406;
 pub const DOUBLE: u32 = 0x140A;
 
 pub const RGBA: u32 = 0x1908;
+pub const RGB: u32 = 0x1907;
+pub const REPEAT: u32 = 0x2901;
+pub const MODULATE: u32 = 0x2100;
+pub const DECAL: u32 = 0x2101;
+pub const REPLACE: u32 = 0x1E01;
+pub const ADD: u32 = 0x0104;
+/// `GL_BLEND` as a texture environment mode.
+pub const BLEND_ENV: u32 = 0x0BE2;
+pub const TEXTURE_ENV_MODE: u32 = 0x2200;
+pub const TEXTURE_ENV_COLOR: u32 = 0x2201;
+pub const TEXTURE_MAG_FILTER: u32 = 0x2800;
+pub const TEXTURE_MIN_FILTER: u32 = 0x2801;
+pub const TEXTURE_WRAP_S: u32 = 0x2802;
+pub const TEXTURE_WRAP_T: u32 = 0x2803;
+pub const NEAREST: u32 = 0x2600;
+pub const NEVER: u32 = 0x0200;
+pub const LESS: u32 = 0x0201;
+pub const EQUAL: u32 = 0x0202;
+pub const LEQUAL: u32 = 0x0203;
+pub const NOTEQUAL: u32 = 0x0205;
+pub const GEQUAL: u32 = 0x0206;
+pub const ALWAYS: u32 = 0x0207;
 pub const BACK_BUFFER: u32 = 0x0405;
 pub const VIEWPORT: u32 = 0x0BA2;
 

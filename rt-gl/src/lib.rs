@@ -34,7 +34,9 @@
 //! `counters.txt`), `RT_GL_DUMP_RASTER=1` (also what the real GL drew, as
 //! `raster-NNNN.png`), `RT_GL_STATS=1` (counters per frame on stderr:
 //! [`record::Counters`] — builds, refits and reuses of lists and buffer
-//! draws, instances, triangles, ignored calls).
+//! draws, instances, triangles, ignored calls — and each pass),
+//! `RT_GL_ASYNC=1` (frames traced on a worker thread while the program
+//! swaps at its own rate; each swap shows the newest traced frame).
 
 // A std-only library loaded into programs: the no_std import lints of the
 // workspace do not apply.

@@ -139,17 +139,16 @@ fn take(buffer: u32) -> Option<Taken> {
     {
         log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
     }
-    if std::env::var("RT_GL_DEBUG_PASSES").is_ok() {
-        for (v, p) in &passes {
+    if cfg.stats {
+        for (k, (v, p)) in passes.iter().enumerate() {
+            let d = &p.draws;
             eprintln!(
-                "frame {n} pass vp={v:?} overlay={} depth={} cleared={} tris={} inst={} lit={} p={:?}",
-                p.view.is_kept(*v),
+                "rt-gl: frame {n} pass {k}: viewport {v:?}, {}, depth test {}, depth cleared {}, {} immediate triangles, {} instances",
+                if p.view.is_kept(*v) { "kept as GL drew it" } else { "traced" },
                 p.view.depth_test,
                 p.depth_cleared,
-                p.draws.immediate.triangles.len(),
-                p.draws.instances.len(),
-                p.draws.lighting.is_some(),
-                p.view.projection.to_cols_array()
+                d.immediate.triangles.len(),
+                d.instances.len(),
             );
         }
     }

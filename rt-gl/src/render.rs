@@ -12,7 +12,7 @@
 //! own image (the `gl` mode) needs exactly GL's equation; rt-accel's BVH
 //! answers the rays.
 
-use std::sync::Arc;
+use std::{collections::HashMap, sync::Arc};
 
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
@@ -23,7 +23,8 @@ use rt_core::{
 
 use crate::gl;
 use crate::record::{
-    Fog, FrameDraws, Geometry, GeometryError, Lighting, Paint, Recorded, Shading, normal_matrix,
+    Fog, FrameDraws, Geometry, GeometryError, Lighting, Paint, Recorded, Shading, alpha_passes,
+    normal_matrix, texture::Texture,
 };
 
 /// How frames are lit: GL's fixed-function model, or ray-traced.
@@ -195,6 +196,8 @@ pub struct FrameScene {
     normal: Vec<Mat3>,
     /// Per instance: what its call paints it with.
     paint: Vec<Option<Paint>>,
+    /// The frame's textures, by name.
+    textures: Arc<HashMap<u32, Arc<Texture>>>,
     /// The pass's fog, for its fogged primitives.
     fog: Option<Fog>,
     diagonal: f32,
@@ -258,6 +261,7 @@ impl FrameScene {
             normal,
             paint,
             fog: frame.fog,
+            textures: frame.textures,
             diagonal,
             left_out,
         })
@@ -273,31 +277,56 @@ impl FrameScene {
     /// The closest hit among the immediate geometry and the instances,
     /// past the faces culled (`glCullFace`): up to [`MAX_LAYERS`] of them,
     /// each passed through as the ray's next segment.
-    fn closest(&self, ray: &Ray) -> Option<(Source, Hit)> {
+    /// `flip`: the projection mirrors (see [`ShadeCtx::flip`]).
+    fn closest(&self, ray: &Ray, flip: bool) -> Option<(Source, Hit)> {
         // The distance passed through culled faces, in the ray's units
         // (its direction is kept): hits are measured from its origin.
         let (mut r, mut passed) = (*ray, 0.0);
         for _ in 0..MAX_LAYERS {
             let (src, mut hit) = self.closest_any(&r)?;
-            let back = hit.normal.dot(r.direction) > 0.0;
+            let back = (hit.normal.dot(r.direction) > 0.0) != flip;
+            let s = self.surface(src, &hit);
             let culled = hit.kind == PrimKind::Triangle
-                && match self.surface(src, &hit).0.cull {
+                && match s.shading.cull {
                     gl::FRONT_AND_BACK => true,
                     gl::BACK => back,
                     gl::FRONT => !back,
                     _ => false,
                 };
+            // The alpha test discards the fragment: the ray goes on.
+            let discarded = s
+                .shading
+                .alpha_test
+                .is_some_and(|test| !alpha_passes(test, self.fragment_alpha(&s)));
+            let culled = culled || discarded;
             if !culled {
                 hit.t += passed;
                 return Some((src, hit));
             }
             passed += hit.t;
-            let side = if back { hit.normal } else { -hit.normal };
+            let side = if hit.normal.dot(r.direction) > 0.0 { hit.normal } else { -hit.normal };
             let mut on = spawn_ray(hit.position, hit.position_error, side, r.direction);
             on.t_max = (r.t_max - hit.t).max(0.0);
             r = on;
         }
         None
+    }
+
+    /// `c` textured as `sh` says (unchanged when untextured).
+    fn texture(&self, sh: &Shading, c: Vec4, uv: Vec2) -> Vec4 {
+        match sh.texture.and_then(|t| Some((t, self.textures.get(&t.name)?))) {
+            Some((t, tex)) => t.env.apply(c, tex.sample(uv), tex.format),
+            None => c,
+        }
+    }
+
+    /// The fragment's alpha before lighting's effect on it (the material's
+    /// diffuse alpha when lit, the colour's unlit), textured: what GL's
+    /// alpha test compares.
+    fn fragment_alpha(&self, s: &Surface) -> f32 {
+        let sh = &s.shading;
+        let a = if sh.lit { sh.material_with(s.color).diffuse.w } else { s.color.w };
+        self.texture(sh, s.color.truncate().extend(a), s.uv).w
     }
 
     /// The closest hit, culled or not.
@@ -425,6 +454,7 @@ impl FrameScene {
         let (w, n) = (width as usize, width as usize * height as usize);
         let mut rgba = vec![0u8; if shade.is_some() { 4 * n } else { 0 }];
         let mut depth = vec![f32::INFINITY; n];
+        let flip = projection.determinant() > 0.0;
         let pixel = |x: usize, y: usize, px: Option<&mut [u8]>, z: &mut f32| {
             let ndc = Vec2::new(
                 2.0 * (x as f32 + 0.5) / width as f32 - 1.0,
@@ -434,7 +464,7 @@ impl FrameScene {
             let far = inv.project_point3(ndc.extend(1.0));
             // Parameter 0..1 spans the near to the far plane: GL's clipping.
             let ray = Ray::with_range(near, far - near, 0.0, 1.0);
-            let hit = self.closest(&ray);
+            let hit = self.closest(&ray, flip);
             if let Some((_, h)) = &hit {
                 let ndc_z = projection.project_point3(h.position).z;
                 *z = if ndc_z.is_finite() { (0.5 * ndc_z + 0.5).clamp(0.0, 1.0) } else { 0.0 };
@@ -449,6 +479,7 @@ impl FrameScene {
                             opts: s.opts,
                             background: s.background,
                             seed,
+                            flip,
                         };
                         to_rgba8(self.shade_through(&ray, first, &ctx))
                     }
@@ -479,7 +510,7 @@ impl FrameScene {
     /// The shading, colour, normal (eye space) and normal length (GL's,
     /// interpolated as Gouraud shading interpolates what it lights with)
     /// at a hit.
-    fn surface(&self, src: Source, hit: &Hit) -> (Shading, Vec4, Vec3, f32) {
+    fn surface(&self, src: Source, hit: &Hit) -> Surface {
         let (g, nm, paint) = match src {
             Source::Immediate => (&self.immediate, Mat3::IDENTITY, None),
             Source::Instance(i) => {
@@ -499,13 +530,16 @@ impl FrameScene {
     /// give theirs there already).
     /// `paint`: the instance's call's shading and colour, where they
     /// replace the recording's.
-    fn surface_in(
-        g: &Geometry,
-        hit: &Hit,
-        nm: Mat3,
-        paint: Option<&Paint>,
-    ) -> (Shading, Vec4, Vec3, f32) {
+    fn surface_in(g: &Geometry, hit: &Hit, nm: Mat3, paint: Option<&Paint>) -> Surface {
         let p = hit.prim as usize;
+        // Texture coordinates: interpolated whatever the shade model.
+        let uv = |w: [f32; 3], v: [usize; 3]| {
+            if g.texcoords.is_empty() {
+                Vec2::ZERO
+            } else {
+                w[0] * g.texcoords[v[0]] + w[1] * g.texcoords[v[1]] + w[2] * g.texcoords[v[2]]
+            }
+        };
         let color = |v: usize| match paint {
             Some(p) if v < p.vertices as usize => p.color,
             _ => g.colors[v],
@@ -516,21 +550,36 @@ impl FrameScene {
                 let [a, b, c] = g.triangles[p].map(|i| i as usize);
                 let (s, pv) = g.triangle_info[p];
                 let sh = shading(s);
+                let w = Vec3::new(1.0 - hit.uv.x - hit.uv.y, hit.uv.x, hit.uv.y);
+                let uv = uv(w.to_array(), [a, b, c]);
                 if sh.flat {
                     let n = nm * g.normals[pv as usize];
-                    (sh, color(pv as usize), n, n.length())
+                    Surface {
+                        shading: sh,
+                        color: color(pv as usize),
+                        normal: n,
+                        length: n.length(),
+                        uv,
+                    }
                 } else {
-                    let w = Vec3::new(1.0 - hit.uv.x - hit.uv.y, hit.uv.x, hit.uv.y);
                     let col = w.x * color(a) + w.y * color(b) + w.z * color(c);
                     let [na, nb, nc] = [a, b, c].map(|v| nm * g.normals[v]);
                     let n = w.x * na + w.y * nb + w.z * nc;
                     let len = w.x * na.length() + w.y * nb.length() + w.z * nc.length();
-                    (sh, col, n, len)
+                    Surface { shading: sh, color: col, normal: n, length: len, uv }
                 }
             }
             PrimKind::Sphere => {
                 let (v, _, s) = g.spheres[p];
-                (shading(s), color(v as usize), hit.normal, 1.0)
+                let v = v as usize;
+                let uv = uv([1.0, 0.0, 0.0], [v; 3]);
+                Surface {
+                    shading: shading(s),
+                    color: color(v),
+                    normal: hit.normal,
+                    length: 1.0,
+                    uv,
+                }
             }
             PrimKind::Capsule => {
                 let ([a, b], _, s) = g.tubes[p];
@@ -542,7 +591,8 @@ impl FrameScene {
                     ((hit.position - pa).dot(d) / d.length_squared()).clamp(0.0, 1.0)
                 };
                 let col = color(a as usize).lerp(color(b as usize), f);
-                (shading(s), col, hit.normal, 1.0)
+                let uv = uv([1.0 - f, f, 0.0], [a as usize, b as usize, b as usize]);
+                Surface { shading: shading(s), color: col, normal: hit.normal, length: 1.0, uv }
             }
         }
     }
@@ -551,12 +601,10 @@ impl FrameScene {
     /// The colour at `hit`: lit (or the vertex colour, unlit), fogged;
     /// alpha its own where it is blended, 1 where it is opaque.
     fn shade(&self, ray: &Ray, src: Source, hit: &Hit, ctx: &ShadeCtx<'_>, depth: u32) -> Vec4 {
-        let (sh, color, normal, length) = self.surface(src, hit);
-        let mut c = if sh.lit {
-            self.light(ray, hit, (&sh, color, normal, length), ctx, depth)
-        } else {
-            color
-        };
+        let surface = self.surface(src, hit);
+        let sh = surface.shading;
+        let mut c = if sh.lit { self.light(ray, hit, &surface, ctx, depth) } else { surface.color };
+        c = self.texture(&sh, c, surface.uv);
         if let (true, Some(fog)) = (sh.fog, &self.fog) {
             // GL's fog coordinate: the eye-space depth's magnitude.
             let f = fog.factor(hit.position.z.abs());
@@ -576,12 +624,19 @@ impl FrameScene {
     fn shade_through(&self, ray: &Ray, first: (Source, Hit), ctx: &ShadeCtx<'_>) -> Vec4 {
         let (mut acc, mut through) = (Vec3::ZERO, 1.0f32);
         let (mut r, mut next) = (*ray, Some(first));
+        let mut nearest_seen = false;
         for _ in 0..MAX_LAYERS {
             let Some((src, hit)) = next else { break };
-            let c = self.shade(&r, src, &hit, ctx, 0);
-            let a = c.w.clamp(0.0, 1.0);
-            acc += through * a * c.truncate();
-            through *= 1.0 - a;
+            // Past the nearest of the surfaces that show their nearest
+            // layer only, the others are passed through unseen.
+            let hidden = self.surface(src, &hit).shading.nearest_only && nearest_seen;
+            if !hidden {
+                let c = self.shade(&r, src, &hit, ctx, 0);
+                let a = c.w.clamp(0.0, 1.0);
+                acc += through * a * c.truncate();
+                through *= 1.0 - a;
+                nearest_seen |= c.w < 1.0 && self.surface(src, &hit).shading.nearest_only;
+            }
             if through < 1.0 / 1024.0 {
                 return acc.extend(1.0);
             }
@@ -590,7 +645,7 @@ impl FrameScene {
             let mut on = spawn_ray(hit.position, hit.position_error, side, r.direction);
             on.t_max = (r.t_max - hit.t).max(0.0);
             r = on;
-            next = self.closest(&r);
+            next = self.closest(&r, ctx.flip);
         }
         acc.extend(1.0 - through)
     }
@@ -600,10 +655,11 @@ impl FrameScene {
         &self,
         ray: &Ray,
         hit: &Hit,
-        (sh, color, normal, length): (&Shading, Vec4, Vec3, f32),
+        surface: &Surface,
         ctx: &ShadeCtx<'_>,
         depth: u32,
     ) -> Vec4 {
+        let Surface { shading: sh, color, normal, length, .. } = *surface;
         let ShadeCtx { lighting, opts, seed, .. } = *ctx;
         // Spheres and tubes carry their own normal; triangles the one
         // the program gave, whose length GL keeps in the lighting dot
@@ -616,11 +672,12 @@ impl FrameScene {
         }
         // GL decides the side by the window-space winding: the geometric
         // normal against the eye ray.
-        let back = hit.normal.dot(ray.direction) > 0.0;
+        let back = (hit.normal.dot(ray.direction) > 0.0) != ctx.flip;
         if back && lighting.two_side {
             n = -n;
         }
-        let geo_n = if back { -hit.normal } else { hit.normal };
+        // The side the ray came from, whatever GL calls it.
+        let geo_n = if hit.normal.dot(ray.direction) > 0.0 { -hit.normal } else { hit.normal };
         let m = sh.material_with(color);
         let rt = opts.mode == Illumination::Rt;
         let ambient_visibility = if rt && depth == 0 && opts.ao_samples > 0 && self.diagonal > 0.0 {
@@ -685,7 +742,7 @@ impl FrameScene {
             // Leave on the side the reflection goes to.
             let side = if r.dot(geo_n) >= 0.0 { geo_n } else { -geo_n };
             let bounce = spawn_ray(p, hit.position_error, side, r);
-            let seen = match self.closest(&bounce) {
+            let seen = match self.closest(&bounce, ctx.flip) {
                 Some((s2, h2)) => self.shade(&bounce, s2, &h2, ctx, depth + 1),
                 None => ctx.background,
             };
@@ -713,6 +770,20 @@ impl FrameScene {
     }
 }
 
+/// What a hit shows before lighting.
+#[derive(Clone, Copy, Debug)]
+struct Surface {
+    shading: Shading,
+    /// The (interpolated) vertex colour.
+    color: Vec4,
+    /// The eye-space normal, interpolated, not made unit.
+    normal: Vec3,
+    /// GL's normal length there (see [`FrameScene::light`]).
+    length: f32,
+    /// Texture coordinates.
+    uv: Vec2,
+}
+
 /// What shading a trace needs besides the scene.
 struct Shade<'a> {
     lighting: &'a Lighting,
@@ -730,6 +801,11 @@ struct ShadeCtx<'a> {
     background: Vec4,
     /// The pixel's seed (AO directions).
     seed: u64,
+    /// The projection keeps eye space's handedness (its determinant is
+    /// positive, as the identity's; glOrtho's and glFrustum's are
+    /// negative): GL tells front from back by the window-space winding,
+    /// so a triangle facing the eye ray is then a back face.
+    flip: bool,
 }
 
 pub(crate) fn to_rgba8(c: Vec4) -> [u8; 4] {

@@ -11,7 +11,7 @@ use alloc::sync::Arc;
 use std::time::Instant;
 
 use rt_accel::BuildError;
-use rt_core::glam::{Mat4, Vec3, Vec4};
+use rt_core::glam::{Mat4, Vec2, Vec3, Vec4};
 use rt_gl::{
     record::{
         Command, FrameDraws, Geometry, GeometryError, Instance, Lighting, MaterialState, Primitive,
@@ -48,6 +48,7 @@ fn good() -> Geometry {
         ],
         normals: vec![Vec3::Z; 6],
         colors: vec![RED, RED, RED, GREEN, BLUE, BLUE],
+        texcoords: vec![Vec2::ZERO; 6],
         triangles: vec![[0, 1, 2]],
         triangle_info: vec![(0, 2)],
         spheres: vec![(3, 0.2, 0)],
@@ -106,6 +107,13 @@ fn cases() -> Vec<Case> {
         ),
         ("a normal too many", |g| g.normals.push(Vec3::Z), attrs(6, 7, 6)),
         ("no colours", |g| g.colors.clear(), attrs(6, 6, 0)),
+        (
+            "a texture coordinate missing",
+            |g| {
+                g.texcoords.pop();
+            },
+            TexcoordCount { positions: 6, texcoords: 5 },
+        ),
         (
             "no triangle_info",
             |g| g.triangle_info.clear(),

@@ -401,6 +401,19 @@ fn polygon_mode_lines_are_traced_as_lines() {
     private_gl_frames_match_the_raster("wireframe", &["wireframe"]);
 }
 
+/// Two textured quads over the ball: an RGB checkerboard (nearest,
+/// modulating the lit colour, texture coordinates repeating twice) and
+/// an RGBA texture (linear, replacing) whose round holes the alpha test
+/// cuts, the ball seen through them. rt-gl traced textured quads flat
+/// white; now every frame agrees with Mesa, no texture call reported.
+#[test]
+#[ignore = "needs xvfb-run, cc, libGL and libX11 headers: CI runs it with --ignored"]
+fn textures_are_traced_with_their_environment_and_alpha_test() {
+    let c = private_gl_frames_match_the_raster("texture", &["texture"]);
+    assert_eq!((c["passes.traced"], c["passes.kept"]), (1, 0), "{c:?}");
+    assert!(!c.keys().any(|k| k.starts_with("unsupported.")), "{c:?}");
+}
+
 /// `RT_GL_ASYNC=1` on a still ball in `rt` mode (shadows, 4 AO rays):
 /// the program swaps at its own rate, each swap showing the newest frame
 /// the worker traced, and while the scene stays still the worker averages

@@ -29,6 +29,8 @@ pub const VERTEX_ARRAY: u32 = 0x8074;
 pub const NORMAL_ARRAY: u32 = 0x8075;
 /// `GL_COLOR_ARRAY`.
 pub const COLOR_ARRAY: u32 = 0x8076;
+/// `GL_TEXTURE_COORD_ARRAY`.
+pub const TEXTURE_COORD_ARRAY: u32 = 0x8078;
 /// Largest buffer shadowed (bigger `glBufferData` calls are not recorded;
 /// draws from them fall back to the program's own image).
 pub const MAX_BUFFER_BYTES: usize = 1 << 30;
@@ -83,11 +85,15 @@ pub(crate) struct ArrayState {
     vertex: Option<ArrayPointer>,
     normal: Option<ArrayPointer>,
     color: Option<ArrayPointer>,
+    texcoord: Option<ArrayPointer>,
     vertex_on: bool,
     normal_on: bool,
     color_on: bool,
+    texcoord_on: bool,
     array_buffer: u32,
     element_buffer: u32,
+    /// `GL_PIXEL_UNPACK_BUFFER`: image pointers are offsets into it.
+    unpack_buffer: u32,
     buffers: HashMap<u32, Buffer>,
     generation: u64,
 }
@@ -100,7 +106,7 @@ pub(crate) struct DrawKey {
     /// of `glDrawElements`.
     range: (usize, usize, u32),
     /// The enabled pointers and the generations of their buffers.
-    arrays: [Option<(ArrayPointer, u64)>; 3],
+    arrays: [Option<(ArrayPointer, u64)>; 4],
     /// The element buffer and its generation (`glDrawElements`).
     elements: Option<(u32, u64)>,
 }
@@ -167,6 +173,7 @@ impl Recorder {
             VERTEX_ARRAY => a.vertex_on = on,
             NORMAL_ARRAY => a.normal_on = on,
             COLOR_ARRAY => a.color_on = on,
+            TEXTURE_COORD_ARRAY => a.texcoord_on = on,
             _ => {}
         }
     }
@@ -184,6 +191,7 @@ impl Recorder {
             VERTEX_ARRAY => a.vertex = Some(p),
             NORMAL_ARRAY => a.normal = Some(p),
             COLOR_ARRAY => a.color = Some(p),
+            TEXTURE_COORD_ARRAY => a.texcoord = Some(p),
             _ => {}
         }
     }
@@ -236,6 +244,16 @@ impl Recorder {
         }
         self.client_state(VERTEX_ARRAY, true);
         self.pointer(VERTEX_ARRAY, vsize, FLOAT, stride, at(voffset));
+        // The T*F formats lead with their texture coordinates.
+        let texcoord = match format {
+            0x2A27 | 0x2A29..=0x2A2C => Some(2),
+            0x2A28 | 0x2A2D => Some(4),
+            _ => None,
+        };
+        self.client_state(TEXTURE_COORD_ARRAY, texcoord.is_some());
+        if let Some(size) = texcoord {
+            self.pointer(TEXTURE_COORD_ARRAY, size, FLOAT, stride, at(0));
+        }
     }
 
     /// `glBindBuffer(target, buffer)`.
@@ -243,8 +261,16 @@ impl Recorder {
         match target {
             ARRAY_BUFFER => self.arrays.array_buffer = buffer,
             ELEMENT_ARRAY_BUFFER => self.arrays.element_buffer = buffer,
+            0x88EC => self.arrays.unpack_buffer = buffer,
             _ => {}
         }
+    }
+
+    /// Whether image pointers are offsets into a pixel buffer object
+    /// (whose contents are not shadowed).
+    #[must_use]
+    pub fn unpacks_from_buffer(&self) -> bool {
+        self.arrays.unpack_buffer != 0
     }
 
     fn bound(&self, target: u32) -> u32 {
@@ -403,6 +429,7 @@ impl Recorder {
         };
         let np = a.normal.filter(|_| a.normal_on);
         let cp = a.color.filter(|_| a.color_on);
+        let tp = a.texcoord.filter(|_| a.texcoord_on);
         self.command(Command::Begin(mode));
         let mut missing = false;
         for i in indices {
@@ -412,6 +439,9 @@ impl Recorder {
             }
             if let Some(n) = np.and_then(|p| unsafe { self.fetch(&p, i, true) }) {
                 self.command(Command::Normal(Vec3::new(n.x, n.y, n.z)));
+            }
+            if let Some(t) = tp.and_then(|p| unsafe { self.fetch(&p, i, false) }) {
+                self.command(Command::TexCoord(t));
             }
             match unsafe { self.fetch(&vp, i, false) } {
                 Some(v) => self.command(Command::Vertex(v)),
@@ -470,7 +500,12 @@ impl Recorder {
         };
         let vertex = gen_of(a.vertex, a.vertex_on)?;
         vertex?;
-        let arrays = [vertex, gen_of(a.normal, a.normal_on)?, gen_of(a.color, a.color_on)?];
+        let arrays = [
+            vertex,
+            gen_of(a.normal, a.normal_on)?,
+            gen_of(a.color, a.color_on)?,
+            gen_of(a.texcoord, a.texcoord_on)?,
+        ];
         let (range, elements) = match idx {
             Indices::Range(first, count) => ((first, count, 0), None),
             Indices::Elements { count, ty, pointer, buffer } => {

@@ -1,18 +1,19 @@
 //! Primitive assembly: the vertices between `glBegin` and `glEnd` turned
 //! into triangles, spheres (points) or tubes (lines).
 
-use glam::{Mat3, Mat4, Vec3, Vec4};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 use super::{Recorder, normal_matrix};
 use crate::gl;
 
-/// A vertex between `glBegin` and `glEnd`: eye-space position, normal and
-/// colour.
-pub(super) type Vert = (Vec3, Vec3, Vec4);
+/// A vertex between `glBegin` and `glEnd`: eye-space position, normal,
+/// colour and texture coordinates (through the texture matrix).
+pub(super) type Vert = (Vec3, Vec3, Vec4, Vec2);
 
 impl Recorder {
     pub(super) fn vertex(&mut self, v: Vec4) {
         let mv = self.modelview();
+        let t = self.texture_matrix() * self.texcoord;
         let Some((_, verts)) = &mut self.begin else {
             self.counters.ignored += 1;
             return;
@@ -22,7 +23,8 @@ impl Recorder {
             return;
         }
         let n = normal_matrix(&mv) * self.normal;
-        verts.push((e.truncate() / e.w, n, self.color));
+        let uv = if t.w == 0.0 { Vec2::ZERO } else { Vec2::new(t.x, t.y) / t.w };
+        verts.push((e.truncate() / e.w, n, self.color, uv));
     }
 
     /// The size of one pixel at eye-space depth `z` (negative in front).
@@ -85,10 +87,17 @@ impl Recorder {
             (&mut self.draws(shading.lit, shading.fog).immediate, Mat4::IDENTITY, Mat3::IDENTITY)
         };
         let base = g.positions.len() as u32;
-        for &(p, n, c) in verts {
+        let textured = shading.texture.is_some() || !g.texcoords.is_empty();
+        if textured {
+            g.texcoords.resize(base as usize, Vec2::ZERO);
+        }
+        for &(p, n, c, uv) in verts {
             g.positions.push(to_local.transform_point3(p));
             g.normals.push(n_to_local * n);
             g.colors.push(c);
+            if textured {
+                g.texcoords.push(uv);
+            }
         }
         let s = g.shading_index(shading);
         let n = verts.len() as u32;

@@ -47,6 +47,13 @@ pub enum GeometryError {
         /// `colors.len()`.
         colors: usize,
     },
+    /// `texcoords` is neither empty nor one entry per position.
+    TexcoordCount {
+        /// `positions.len()`.
+        positions: usize,
+        /// `texcoords.len()`.
+        texcoords: usize,
+    },
     /// `triangle_info` does not hold exactly one entry per triangle.
     TriangleInfoCount {
         /// `triangles.len()`.
@@ -83,6 +90,10 @@ impl fmt::Display for GeometryError {
             Self::VertexAttributeCount { positions, normals, colors } => write!(
                 f,
                 "{positions} positions but {normals} normals and {colors} colours (one per position)"
+            ),
+            Self::TexcoordCount { positions, texcoords } => write!(
+                f,
+                "{positions} positions but {texcoords} texture coordinates (none, or one per position)"
             ),
             Self::TriangleInfoCount { triangles, triangle_info } => write!(
                 f,
@@ -123,7 +134,7 @@ impl Geometry {
     ///
     /// # Errors
     /// The first problem found: [`GeometryError::VertexAttributeCount`],
-    /// [`GeometryError::TriangleInfoCount`],
+    /// [`GeometryError::TexcoordCount`], [`GeometryError::TriangleInfoCount`],
     /// [`GeometryError::VertexOutOfRange`] or
     /// [`GeometryError::ShadingOutOfRange`].
     pub fn check(&self) -> Result<(), GeometryError> {
@@ -133,6 +144,12 @@ impl Geometry {
                 positions: n,
                 normals: self.normals.len(),
                 colors: self.colors.len(),
+            });
+        }
+        if !self.texcoords.is_empty() && self.texcoords.len() != n {
+            return Err(GeometryError::TexcoordCount {
+                positions: n,
+                texcoords: self.texcoords.len(),
             });
         }
         if self.triangle_info.len() != self.triangles.len() {

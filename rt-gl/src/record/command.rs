@@ -62,4 +62,16 @@ pub enum Command {
     /// `glColorMask`: whether any colour channel is written (a depth-only
     /// pass writes none).
     ColorMask(bool),
+    /// `glTexCoord*` (missing coordinates as GL fills them: `t = 0, r =
+    /// 0, q = 1`).
+    TexCoord(Vec4),
+    /// `glBindTexture(target, name)`.
+    BindTexture(u32, u32),
+    /// `glTexEnv*(pname, value)` of `GL_TEXTURE_ENV` (scalars in
+    /// `value[0]`).
+    TexEnv(u32, Vec4),
+    /// `glAlphaFunc(function, reference)`.
+    AlphaFunc(u32, f32),
+    /// `glDepthFunc(function)`.
+    DepthFunc(u32),
 }

@@ -10,11 +10,11 @@
 //! each 3-D pass in its own rectangle and composites them as GL's depth
 //! buffer would (see `composite.rs`).
 
-use std::sync::Arc;
+use std::{collections::HashMap, sync::Arc};
 
 use glam::{Mat4, Vec4};
 
-use super::{Fog, Geometry, GeometryError, Lighting, Recorded, Shading};
+use super::{Fog, Geometry, GeometryError, Lighting, Recorded, Shading, texture::Texture};
 
 /// Most passes kept in one frame: past it, draws join the last pass
 /// (counted in [`Counters::passes_merged`](super::Counters::passes_merged)),
@@ -83,6 +83,9 @@ pub struct FrameDraws {
     /// The fog in force at the pass's last fogged draw (`None`: nothing
     /// fogged was drawn).
     pub fog: Option<Fog>,
+    /// The texture objects at the frame's end, by name (what
+    /// [`Shading::texture`] names).
+    pub textures: Arc<HashMap<u32, Arc<Texture>>>,
 }
 
 impl FrameDraws {
@@ -199,6 +202,7 @@ impl Frame {
             all.instances.extend(d.instances);
             all.lighting = d.lighting.or(all.lighting);
             all.fog = d.fog.or(all.fog);
+            all.textures = d.textures;
         }
         all
     }

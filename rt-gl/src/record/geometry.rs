@@ -1,7 +1,7 @@
 //! Recorded geometry in one space (positions, normals, colours, triangles,
 //! spheres and tubes, with their shadings), and its BVHs.
 
-use glam::{Mat3, Mat4, Vec3, Vec4};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use rt_accel::{BuildError, BuildParams, Scene, build_capsules, build_spheres, build_triangles};
 use rt_core::intersect::{Capsule, Sphere};
 
@@ -20,6 +20,8 @@ pub struct Geometry {
     pub normals: Vec<Vec3>,
     /// Vertex colours, one per position.
     pub colors: Vec<Vec4>,
+    /// Texture coordinates: none, or one per position.
+    pub texcoords: Vec<Vec2>,
     /// Triangles (vertex indices, counter-clockwise as drawn).
     pub triangles: Vec<[u32; 3]>,
     /// Per triangle (one entry each): its shading (index into
@@ -69,6 +71,12 @@ impl Geometry {
         self.positions.extend(other.positions.iter().map(|&p| m.transform_point3(p)));
         self.normals.extend(other.normals.iter().map(|&n| nm * n));
         self.colors.extend_from_slice(&other.colors);
+        if !self.texcoords.is_empty() || !other.texcoords.is_empty() {
+            // Either side without texture coordinates has zeros.
+            self.texcoords.resize(base as usize, Vec2::ZERO);
+            self.texcoords.extend_from_slice(&other.texcoords);
+            self.texcoords.resize(self.positions.len(), Vec2::ZERO);
+        }
         self.triangles.extend(other.triangles.iter().map(|t| t.map(v)));
         self.triangle_info.extend(other.triangle_info.iter().map(|&(k, p)| (s(k), v(p))));
         self.spheres.extend(other.spheres.iter().map(|&(i, r, k)| (v(i), r * scale, s(k))));

@@ -3,6 +3,8 @@
 
 use glam::{Vec3, Vec4};
 
+use super::texture::TexEnv;
+
 use crate::gl;
 
 /// A material's fixed-function parameters (one face).
@@ -157,6 +159,41 @@ pub struct Shading {
     /// `GL_CULL_FACE` was on: the faces culled (`GL_BACK`, `GL_FRONT`,
     /// `GL_FRONT_AND_BACK`; 0: none). Rays pass through them.
     pub cull: u32,
+    /// The 2-D texture applied (`GL_TEXTURE_2D` on, a complete texture
+    /// bound), and how.
+    pub texture: Option<TextureUse>,
+    /// `GL_ALPHA_TEST` on: `glAlphaFunc`'s function and reference; rays
+    /// pass through fragments it discards.
+    pub alpha_test: Option<(u32, f32)>,
+    /// Blended under `glDepthFunc(GL_EQUAL)`: after a depth-only pass of
+    /// the same surfaces (the usual way to show only the nearest layer of
+    /// a translucent object), only the nearest such surface on a ray
+    /// shows.
+    pub nearest_only: bool,
+}
+
+/// A texture as a primitive uses it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureUse {
+    /// The texture object's name (looked up in the frame's textures).
+    pub name: u32,
+    /// The texture environment.
+    pub env: TexEnv,
+}
+
+/// Whether alpha `a` passes GL's alpha test `(function, reference)`.
+#[must_use]
+pub fn alpha_passes((func, reference): (u32, f32), a: f32) -> bool {
+    match func {
+        gl::NEVER => false,
+        gl::LESS => a < reference,
+        gl::EQUAL => a == reference,
+        gl::LEQUAL => a <= reference,
+        gl::GREATER => a > reference,
+        gl::NOTEQUAL => a != reference,
+        gl::GEQUAL => a >= reference,
+        _ => true,
+    }
 }
 
 impl Shading {

@@ -25,8 +25,8 @@ pub(super) struct List {
     cacheable: bool,
     /// Calls other lists: cached entries also depend on their definitions.
     nested: bool,
-    /// Sets no shading state (materials, lighting and colour-material
-    /// switches, shade model, normalization) and calls no list: every
+    /// Sets no shading state (materials, switches, shade model, textures,
+    /// alpha, blend and cull functions) and calls no list: every
     /// primitive takes the caller's shading, and the vertices before its
     /// first `glColor` the caller's colour, so one recording serves every
     /// calling colour and material, each call painting its instance.
@@ -165,12 +165,15 @@ impl Recorder {
                     | Command::Material(..)
                     | Command::ColorMaterial(..)
                     | Command::ShadeModel(_)
-                    | Command::Enable(
-                        gl::LIGHTING | gl::COLOR_MATERIAL | gl::NORMALIZE | gl::RESCALE_NORMAL
-                    )
-                    | Command::Disable(
-                        gl::LIGHTING | gl::COLOR_MATERIAL | gl::NORMALIZE | gl::RESCALE_NORMAL
-                    )
+                    | Command::BindTexture(..)
+                    | Command::TexEnv(..)
+                    | Command::AlphaFunc(..)
+                    | Command::DepthFunc(_)
+                    | Command::BlendFunc(..)
+                    | Command::CullFace(_)
+                    | Command::ColorMask(_)
+                    | Command::Enable(_)
+                    | Command::Disable(_)
             )
         });
         let overrides = Overrides::of(&commands);

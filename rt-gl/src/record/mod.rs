@@ -30,6 +30,7 @@
 //! - `frame.rs`: [`Frame`], its [`Pass`]es and their [`FrameDraws`];
 //!   `counters.rs`: [`Counters`].
 //! - `matrix.rs`: the matrices of GL's matrix calls.
+//! - [`texture`]: 2-D textures, their unpacking, sampling and environment.
 
 pub mod arrays;
 mod assemble;
@@ -44,6 +45,7 @@ mod lists;
 mod matrix;
 mod recorded;
 mod recorder;
+pub mod texture;
 
 pub use arrays::ArrayPointer;
 pub use check::{GeometryError, Primitive};
@@ -51,7 +53,7 @@ pub use command::Command;
 pub use counters::Counters;
 pub use frame::{Frame, FrameDraws, Instance, MAX_PASSES, Paint, Pass, View};
 pub use geometry::Geometry;
-pub use lighting::{Fog, LightState, Lighting, MaterialState, Shading};
+pub use lighting::{Fog, LightState, Lighting, MaterialState, Shading, TextureUse, alpha_passes};
 pub use lists::{LIST_BUDGET, MAX_LIST_NESTING};
 pub use matrix::{frustum, normal_matrix, ortho, rotate, scale, translate};
 pub use recorded::Recorded;

@@ -10,12 +10,13 @@ use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use super::{
     Command, Counters, Fog, Frame, FrameDraws, LIST_BUDGET, Lighting, MAX_PASSES, MaterialState,
-    Pass, Recorded, Shading, View,
+    Pass, Recorded, Shading, TextureUse, View,
     arrays::{ArrayState, DrawKey},
     assemble::Vert,
     capture::{Capture, Inherited},
     lighting::apply_color_material,
     lists::List,
+    texture::{self, BaseFormat, PixelStore, TexEnv, Texture},
 };
 use crate::gl;
 
@@ -34,6 +35,23 @@ pub struct Recorder {
     pub clear_color: Vec4,
     pub(super) color: Vec4,
     pub(super) normal: Vec3,
+    /// `glTexCoord`.
+    pub(super) texcoord: Vec4,
+    /// Texture objects by name (level 0), the one bound to
+    /// `GL_TEXTURE_2D`, unit 0's environment, the unpack state, whether
+    /// unit 0 is the active one, and `GL_TEXTURE_GEN_*` switches.
+    pub(super) textures: HashMap<u32, Arc<Texture>>,
+    bound_texture: u32,
+    tex_env: TexEnv,
+    /// `glPixelStore`'s unpack state.
+    pub unpack: PixelStore,
+    unit0: bool,
+    texgen: u8,
+    /// `glDepthFunc`.
+    depth_func: u32,
+    /// `GL_ALPHA_TEST` and `glAlphaFunc`.
+    alpha_test_on: bool,
+    alpha_func: (u32, f32),
     pub(super) point_size: f32,
     pub(super) line_width: f32,
     lit: bool,
@@ -82,8 +100,6 @@ pub struct Recorder {
     depth_test: bool,
     /// Which texture targets are on (a bit each).
     texture_targets: u8,
-    /// A texture target (`GL_TEXTURE_1D`, `_2D`, `_3D`, `_CUBE_MAP`) is on.
-    textured: bool,
     /// `GL_SCISSOR_TEST` is on (a colour clear then clears a rectangle,
     /// not the frame).
     scissor: bool,
@@ -125,6 +141,16 @@ impl Recorder {
             clear_color: Vec4::ZERO,
             color: Vec4::ONE,
             normal: Vec3::Z,
+            texcoord: Vec4::W,
+            textures: HashMap::new(),
+            bound_texture: 0,
+            tex_env: TexEnv::default(),
+            unpack: PixelStore::default(),
+            unit0: true,
+            texgen: 0,
+            alpha_test_on: false,
+            depth_func: gl::LESS,
+            alpha_func: (gl::ALWAYS, 0.0),
             point_size: 1.0,
             line_width: 1.0,
             lit: false,
@@ -155,7 +181,6 @@ impl Recorder {
             cache: HashMap::new(),
             frame: Frame::default(),
             depth_test: false,
-            textured: false,
             texture_targets: 0,
             scissor: false,
             background: Vec4::ZERO,
@@ -173,6 +198,12 @@ impl Recorder {
     #[must_use]
     pub fn modelview(&self) -> Mat4 {
         *self.modelview.last().unwrap_or(&Mat4::IDENTITY)
+    }
+
+    /// The current texture matrix.
+    #[must_use]
+    pub fn texture_matrix(&self) -> Mat4 {
+        *self.texture.last().unwrap_or(&Mat4::IDENTITY)
     }
 
     /// The current projection matrix.
@@ -194,7 +225,7 @@ impl Recorder {
             projection: self.projection(),
             viewport: self.viewport,
             depth_test: self.depth_test,
-            textured: self.textured,
+            textured: self.untraced_texturing(),
         }
     }
 
@@ -255,7 +286,12 @@ impl Recorder {
             })
             .sum::<usize>() as u64;
         self.depth_cleared = false;
-        core::mem::take(&mut self.frame)
+        let textures = Arc::new(self.textures.clone());
+        let mut frame = core::mem::take(&mut self.frame);
+        for p in &mut frame.passes {
+            p.draws.textures = Arc::clone(&textures);
+        }
+        frame
     }
 
     /// `glClear(mask)`: clearing the colour buffer starts the frame over
@@ -318,6 +354,9 @@ impl Recorder {
             fog: self.fog_on,
             blend: self.blend_on && self.blend_over,
             cull: if self.cull_on { self.cull_face } else { 0 },
+            texture: self.texture_use(),
+            alpha_test: self.alpha_test_on.then_some(self.alpha_func),
+            nearest_only: self.blend_on && self.blend_over && self.depth_func == gl::EQUAL,
             flat: self.flat,
             material,
             color_material: self.color_material_on.then_some(self.color_material.1),
@@ -442,6 +481,27 @@ impl Recorder {
                 _ => self.counters.ignored += 1,
             },
             Command::ColorMask(any) => self.color_write = any,
+            Command::TexCoord(t) => self.texcoord = t,
+            Command::BindTexture(target, name) => {
+                if target == gl::TEXTURE_2D && self.unit0 {
+                    self.bound_texture = name;
+                }
+            }
+            Command::TexEnv(pname, v) => {
+                if self.unit0 {
+                    match pname {
+                        gl::TEXTURE_ENV_MODE => self.tex_env.mode = v.x as u32,
+                        gl::TEXTURE_ENV_COLOR => {
+                            self.tex_env.color = v.clamp(Vec4::ZERO, Vec4::ONE);
+                        }
+                        _ => {}
+                    }
+                }
+            }
+            Command::DepthFunc(func) => self.depth_func = func,
+            Command::AlphaFunc(func, reference) => {
+                self.alpha_func = (func, reference.clamp(0.0, 1.0));
+            }
             Command::CullFace(face) => match face {
                 gl::FRONT | gl::BACK | gl::FRONT_AND_BACK => self.cull_face = face,
                 _ => self.counters.ignored += 1,
@@ -449,9 +509,145 @@ impl Recorder {
             Command::BlendFunc(src, dst) => {
                 self.blend_over = (src, dst) == (gl::SRC_ALPHA, gl::ONE_MINUS_SRC_ALPHA);
                 if !self.blend_over {
-                    self.unsupported("glBlendFunc (other than SRC_ALPHA, ONE_MINUS_SRC_ALPHA)");
+                    self.unsupported("glBlendFunc.other_than_src_alpha");
                 }
             }
+        }
+    }
+
+    /// Texturing the trace does not do: 1-D, 3-D or cube-map textures,
+    /// generated texture coordinates, or a 2-D texture whose image could
+    /// not be read.
+    fn untraced_texturing(&self) -> bool {
+        let on_2d = self.texture_targets & 2 != 0;
+        let unread = || self.textures.get(&self.bound_texture).is_some_and(|t| !t.readable);
+        self.texture_targets & !2 != 0 || (on_2d && (self.texgen != 0 || unread()))
+    }
+
+    /// The 2-D texture a draw made now is textured with.
+    fn texture_use(&self) -> Option<TextureUse> {
+        let on = self.texture_targets & 2 != 0;
+        let complete =
+            self.textures.get(&self.bound_texture).is_some_and(|t| t.is_complete() && t.readable);
+        (on && complete).then_some(TextureUse { name: self.bound_texture, env: self.tex_env })
+    }
+
+    /// `glActiveTexture(unit)`: only unit 0 (`GL_TEXTURE0`) is traced;
+    /// texture calls for the others are left to GL.
+    pub fn active_texture(&mut self, unit: u32) {
+        self.unit0 = unit == 0x84C0;
+        if !self.unit0 {
+            self.unsupported("glActiveTexture.other_units");
+        }
+    }
+
+    /// The bound 2-D texture object, made if it does not exist yet.
+    fn bound_2d(&mut self) -> &mut Texture {
+        Arc::make_mut(self.textures.entry(self.bound_texture).or_default())
+    }
+
+    /// `glTexImage2D(GL_TEXTURE_2D, level, internal, width, height, …)`
+    /// with the client image `data` (spanning
+    /// [`PixelStore::image_bytes`]; `None`: no image, the texels
+    /// undefined). Levels other than 0 are not kept.
+    #[allow(clippy::too_many_arguments)]
+    pub fn tex_image_2d(
+        &mut self,
+        target: u32,
+        level: i32,
+        internal: u32,
+        [width, height]: [i32; 2],
+        format: u32,
+        ty: u32,
+        data: Option<&[u8]>,
+    ) {
+        if target != gl::TEXTURE_2D || level != 0 || !self.unit0 {
+            return;
+        }
+        let max = texture::MAX_TEXTURE_SIZE as i32;
+        if !(0..=max).contains(&width) || !(0..=max).contains(&height) {
+            self.counters.ignored += 1;
+            return;
+        }
+        let unpack = self.unpack;
+        let t = self.bound_2d();
+        t.width = width as u32;
+        t.height = height as u32;
+        t.format = BaseFormat::of(internal);
+        t.texels = vec![[255; 4]; width as usize * height as usize];
+        let size = [width as usize, height as usize];
+        // No data: texels GL leaves undefined, for glTexSubImage2D.
+        t.readable = data.is_none_or(|d| t.store([0, 0], size, format, ty, d, &unpack));
+        if !t.readable {
+            self.unsupported("glTexImage2D.unread_format");
+        }
+    }
+
+    /// `glTexSubImage2D(GL_TEXTURE_2D, 0, x, y, width, height, …)` with
+    /// the client image `data` (`None`: not readable, as from a pixel
+    /// buffer object).
+    #[allow(clippy::too_many_arguments)]
+    pub fn tex_sub_image_2d(
+        &mut self,
+        target: u32,
+        level: i32,
+        [x, y]: [i32; 2],
+        [width, height]: [i32; 2],
+        format: u32,
+        ty: u32,
+        data: Option<&[u8]>,
+    ) {
+        if target != gl::TEXTURE_2D || level != 0 || !self.unit0 {
+            return;
+        }
+        if x < 0 || y < 0 || width < 0 || height < 0 {
+            self.counters.ignored += 1;
+            return;
+        }
+        let unpack = self.unpack;
+        let t = self.bound_2d();
+        let at = [x as usize, y as usize];
+        let size = [width as usize, height as usize];
+        if !data.is_some_and(|d| t.store(at, size, format, ty, d, &unpack)) {
+            t.readable = false;
+            self.unsupported("glTexSubImage2D.unread_format");
+        }
+    }
+
+    /// `glTexParameter*(GL_TEXTURE_2D, pname, value)`.
+    pub fn tex_parameter(&mut self, target: u32, pname: u32, value: f32) {
+        if target != gl::TEXTURE_2D || !self.unit0 {
+            return;
+        }
+        let v = value as u32;
+        match pname {
+            gl::TEXTURE_WRAP_S => self.bound_2d().wrap[0] = v,
+            gl::TEXTURE_WRAP_T => self.bound_2d().wrap[1] = v,
+            gl::TEXTURE_MAG_FILTER => self.bound_2d().linear[0] = v != gl::NEAREST,
+            // LINEAR and LINEAR_MIPMAP_* filter linearly within a level.
+            gl::TEXTURE_MIN_FILTER => {
+                self.bound_2d().linear[1] = matches!(v, 0x2601 | 0x2701 | 0x2703);
+            }
+            _ => {}
+        }
+    }
+
+    /// `glDeleteTextures`.
+    pub fn delete_textures(&mut self, names: &[u32]) {
+        for n in names {
+            self.textures.remove(n);
+        }
+    }
+
+    /// `glPixelStorei(pname, value)` (the unpack state; packing is GL's).
+    pub fn pixel_store(&mut self, pname: u32, value: i32) {
+        let Ok(v) = usize::try_from(value) else { return };
+        match pname {
+            0x0CF5 if matches!(v, 1 | 2 | 4 | 8) => self.unpack.alignment = v,
+            0x0CF2 => self.unpack.row_length = v,
+            0x0CF3 => self.unpack.skip_rows = v,
+            0x0CF4 => self.unpack.skip_pixels = v,
+            _ => {}
         }
     }
 
@@ -470,6 +666,11 @@ impl Recorder {
             gl::FOG => self.fog_on = on,
             gl::BLEND => self.blend_on = on,
             gl::CULL_FACE => self.cull_on = on,
+            gl::ALPHA_TEST => self.alpha_test_on = on,
+            0x0C60..=0x0C63 if self.unit0 => {
+                let bit = 1 << (cap - 0x0C60);
+                self.texgen = if on { self.texgen | bit } else { self.texgen & !bit };
+            }
             gl::RESCALE_NORMAL => self.normalize[1] = on,
             gl::DEPTH_TEST => self.depth_test = on,
             // One texture unit's targets: any on makes draws textured.
@@ -480,9 +681,10 @@ impl Recorder {
                     0x806F => 4,
                     _ => 8,
                 };
-                self.texture_targets =
-                    if on { self.texture_targets | bit } else { self.texture_targets & !bit };
-                self.textured = self.texture_targets != 0;
+                if self.unit0 {
+                    self.texture_targets =
+                        if on { self.texture_targets | bit } else { self.texture_targets & !bit };
+                }
             }
             gl::SCISSOR_TEST => self.scissor = on,
             gl::COLOR_MATERIAL => {
@@ -527,11 +729,9 @@ impl Recorder {
 fn unsupported_cap(cap: u32) -> Option<&'static str> {
     Some(match cap {
         0x0DE0 => "GL_TEXTURE_1D",
-        0x0DE1 => "GL_TEXTURE_2D",
+        0x0C60..=0x0C63 => "GL_TEXTURE_GEN",
         0x806F => "GL_TEXTURE_3D",
         0x8513 => "GL_TEXTURE_CUBE_MAP",
-        0x0C60..=0x0C63 => "GL_TEXTURE_GEN",
-        0x0BC0 => "GL_ALPHA_TEST",
         0x0B90 => "GL_STENCIL_TEST",
         0x0B24 => "GL_LINE_STIPPLE",
         0x0B42 => "GL_POLYGON_STIPPLE",

@@ -46,6 +46,11 @@
  *                       With `wireframe`, the ball as its edges
  *                       (glPolygonMode GL_LINE), unlit.
  *                       With `still`, the ball does not turn.
+ *                       With `texture`, a checkerboard (RGB, nearest,
+ *                       modulating the lit colour) on a turning quad,
+ *                       and in front of the ball a quad whose RGBA
+ *                       texture (linear, replacing the colour) has round
+ *                       holes cut by the alpha test.
  *
  * Build: cc -O2 -o private_gl private_gl.c -lX11 -ldl -lm
  */
@@ -194,6 +199,49 @@ int main(int argc, char **argv) {
     int blend = strcmp(mode, "blend") == 0;
     int wireframe = strcmp(mode, "wireframe") == 0;
     int still = strcmp(mode, "still") == 0;
+    int texture = strcmp(mode, "texture") == 0;
+    void (*genTextures)(GLsizei, GLuint *) = (void *)need("glGenTextures");
+    void (*bindTexture)(GLenum, GLuint) = (void *)need("glBindTexture");
+    void (*texImage2D)(GLenum, GLint, GLint, GLsizei, GLsizei, GLint, GLenum, GLenum,
+                       const void *) = (void *)need("glTexImage2D");
+    void (*texParameteri)(GLenum, GLenum, GLint) = (void *)need("glTexParameteri");
+    void (*texEnvi)(GLenum, GLenum, GLint) = (void *)need("glTexEnvi");
+    void (*texCoord2f)(GLfloat, GLfloat) = (void *)need("glTexCoord2f");
+    void (*alphaFunc)(GLenum, GLclampf) = (void *)need("glAlphaFunc");
+    void (*pixelStorei)(GLenum, GLint) = (void *)need("glPixelStorei");
+    GLuint tex[2] = {0, 0};
+    if (texture) {
+        /* An 8x8 RGB checkerboard, rows of 3 bytes: unpack alignment 1. */
+        static GLubyte checker[8][8][3];
+        for (int i = 0; i < 8; i++)
+            for (int j = 0; j < 8; j++) {
+                int on = (i + j) % 2;
+                checker[i][j][0] = on ? 240 : 40;
+                checker[i][j][1] = on ? 230 : 90;
+                checker[i][j][2] = on ? 60 : 200;
+            }
+        /* A 32x32 RGBA disc grid: alpha 0 inside four round holes. */
+        static GLubyte holes[32][32][4];
+        for (int i = 0; i < 32; i++)
+            for (int j = 0; j < 32; j++) {
+                double x = (j % 16) - 7.5, y = (i % 16) - 7.5;
+                holes[i][j][0] = 200;
+                holes[i][j][1] = (GLubyte)(60 + 6 * i);
+                holes[i][j][2] = (GLubyte)(60 + 6 * j);
+                holes[i][j][3] = x * x + y * y < 30.0 ? 0 : 255;
+            }
+        genTextures(2, tex);
+        pixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        bindTexture(GL_TEXTURE_2D, tex[0]);
+        texImage2D(GL_TEXTURE_2D, 0, GL_RGB, 8, 8, 0, GL_RGB, GL_UNSIGNED_BYTE, checker);
+        texParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        texParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        bindTexture(GL_TEXTURE_2D, tex[1]);
+        pixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        texImage2D(GL_TEXTURE_2D, 0, GL_RGBA, 32, 32, 0, GL_RGBA, GL_UNSIGNED_BYTE, holes);
+        texParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        texParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    }
     void (*fogi)(GLenum, GLint) = (void *)need("glFogi");
     void (*fogf)(GLenum, GLfloat) = (void *)need("glFogf");
     void (*fogfv)(GLenum, const GLfloat *) = (void *)need("glFogfv");
@@ -245,6 +293,67 @@ int main(int argc, char **argv) {
     enable(GL_COLOR_MATERIAL);
     GLfloat pos[4] = {1.0f, 2.0f, 3.0f, 0.0f};
     for (int f = 0; f < frames; f++) {
+        if (texture) {
+            clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+            matrixMode(GL_PROJECTION);
+            loadIdentity();
+            frustum(-0.6, 0.6, -0.6, 0.6, 1.0, 20.0);
+            matrixMode(GL_MODELVIEW);
+            loadIdentity();
+            lightfv(GL_LIGHT0, GL_POSITION, pos);
+            /* The ball, behind, untextured. */
+            pushMatrix();
+            translatef(0.4f, 0.3f, -6.0f);
+            p_color3f(0.9f, 0.5f, 0.2f);
+            ball();
+            popMatrix();
+            enable(GL_TEXTURE_2D);
+            /* The checkerboard, lit and modulated, turning. */
+            pushMatrix();
+            translatef(-1.0f, -1.0f, -5.0f);
+            rotatef(25.0f * f, 0.0f, 1.0f, 0.0f);
+            bindTexture(GL_TEXTURE_2D, tex[0]);
+            texEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+            p_color3f(1.0f, 1.0f, 1.0f);
+            begin(GL_QUADS);
+            normal3f(0.0f, 0.0f, 1.0f);
+            texCoord2f(0.0f, 0.0f);
+            vertex3f(-1.0f, -1.0f, 0.0f);
+            texCoord2f(2.0f, 0.0f);
+            vertex3f(1.0f, -1.0f, 0.0f);
+            texCoord2f(2.0f, 2.0f);
+            vertex3f(1.0f, 1.0f, 0.0f);
+            texCoord2f(0.0f, 2.0f);
+            vertex3f(-1.0f, 1.0f, 0.0f);
+            end();
+            popMatrix();
+            /* The holed quad in front of the ball, unlit, replacing. */
+            disable(GL_LIGHTING);
+            enable(GL_ALPHA_TEST);
+            alphaFunc(GL_GREATER, 0.5f);
+            bindTexture(GL_TEXTURE_2D, tex[1]);
+            texEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_REPLACE);
+            pushMatrix();
+            translatef(0.6f, 0.5f, -4.0f);
+            rotatef(10.0f * f, 0.0f, 0.0f, 1.0f);
+            begin(GL_QUADS);
+            texCoord2f(0.0f, 0.0f);
+            vertex3f(-0.9f, -0.9f, 0.0f);
+            texCoord2f(1.0f, 0.0f);
+            vertex3f(0.9f, -0.9f, 0.0f);
+            texCoord2f(1.0f, 1.0f);
+            vertex3f(0.9f, 0.9f, 0.0f);
+            texCoord2f(0.0f, 1.0f);
+            vertex3f(-0.9f, 0.9f, 0.0f);
+            end();
+            popMatrix();
+            disable(GL_ALPHA_TEST);
+            disable(GL_TEXTURE_2D);
+            enable(GL_LIGHTING);
+            swapBuffers(dpy, win);
+            finish();
+            continue;
+        }
         if (fog || blend || wireframe) {
             clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
             matrixMode(GL_PROJECTION);
