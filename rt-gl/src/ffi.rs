@@ -366,8 +366,21 @@ intercept! {
     glPixelStorei(pname: u32, v: i32) { with_recorder(|r| r.pixel_store(pname, v)); }
     glAlphaFunc(func: u32, reference: f32) { rec(Command::AlphaFunc(func, reference)) }
     glDepthFunc(func: u32) { rec(Command::DepthFunc(func)) }
-    glBitmap(w: i32, h: i32, xo: f32, yo: f32, xm: f32, ym: f32, b: *const u8) { let _ = (w, h, xo, yo, xm, ym, b); unsupported("glBitmap") }
-    glDrawPixels(w: i32, h: i32, format: u32, ty: u32, data: *const c_void) { let _ = (w, h, format, ty, data); unsupported("glDrawPixels") }
+    glBitmap(w: i32, h: i32, xo: f32, yo: f32, xm: f32, ym: f32, b: *const u8) { let _ = b; rec(Command::Bitmap { size: [w, h], origin: glam::Vec2::new(xo, yo), advance: glam::Vec2::new(xm, ym) }) }
+    glDrawPixels(w: i32, h: i32, format: u32, ty: u32, data: *const c_void) { let _ = (format, ty, data); rec(Command::DrawPixels([w, h])) }
+    glRasterPos2i(x: i32, y: i32) { rec(Command::RasterPos(Vec4::new(x as f32, y as f32, 0.0, 1.0))) }
+    glRasterPos2f(x: f32, y: f32) { rec(Command::RasterPos(Vec4::new(x, y, 0.0, 1.0))) }
+    glRasterPos2d(x: f64, y: f64) { rec(Command::RasterPos(Vec4::new(x as f32, y as f32, 0.0, 1.0))) }
+    glRasterPos3i(x: i32, y: i32, z: i32) { rec(Command::RasterPos(Vec4::new(x as f32, y as f32, z as f32, 1.0))) }
+    glRasterPos3f(x: f32, y: f32, z: f32) { rec(Command::RasterPos(Vec4::new(x, y, z, 1.0))) }
+    glRasterPos3d(x: f64, y: f64, z: f64) { rec(Command::RasterPos(Vec4::new(x as f32, y as f32, z as f32, 1.0))) }
+    glRasterPos4f(x: f32, y: f32, z: f32, w: f32) { rec(Command::RasterPos(Vec4::new(x, y, z, w))) }
+    glRasterPos2fv(v: *const f32) { if let Some([x, y]) = unsafe { read(v) } { rec(Command::RasterPos(Vec4::new(x, y, 0.0, 1.0))) } }
+    glRasterPos3fv(v: *const f32) { if let Some([x, y, z]) = unsafe { read(v) } { rec(Command::RasterPos(Vec4::new(x, y, z, 1.0))) } }
+    glRasterPos3dv(v: *const f64) { if let Some([x, y, z]) = unsafe { read(v) } { rec(Command::RasterPos(Vec4::new(x as f32, y as f32, z as f32, 1.0))) } }
+    glWindowPos2i(x: i32, y: i32) { rec(Command::WindowPos(Vec3::new(x as f32, y as f32, 0.0))) }
+    glWindowPos2f(x: f32, y: f32) { rec(Command::WindowPos(Vec3::new(x, y, 0.0))) }
+    glWindowPos3f(x: f32, y: f32, z: f32) { rec(Command::WindowPos(Vec3::new(x, y, z))) }
     glUseProgram(program: u32) { if program != 0 { unsupported("glUseProgram") } }
     glDisable(cap: u32) { rec(Command::Disable(cap)) }
     glShadeModel(mode: u32) { rec(Command::ShadeModel(mode)) }

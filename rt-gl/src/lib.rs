@@ -75,6 +75,10 @@ pub struct Config {
     /// `RT_GL_ASYNC`: the program swaps at its own rate; frames are traced
     /// on a thread of their own and each swap shows the newest traced.
     pub asynchronous: bool,
+    /// `RT_GL_MODE=off`: calls are forwarded, nothing is recorded or
+    /// traced; swaps are only counted (`RT_GL_STATS`): the program's own
+    /// frame rate through the interposer.
+    pub off: bool,
     /// `RT_GL_THREADS` (`None`: rayon's global pool, all cores).
     pub pool: Option<rayon::ThreadPool>,
 }
@@ -96,11 +100,13 @@ impl Config {
                 default
             }
         };
+        let mut off = false;
         match var("RT_GL_MODE").as_deref() {
             None | Some("gl") => options.mode = Illumination::Gl,
             Some("rt") => options.mode = Illumination::Rt,
+            Some("off") => off = true,
             Some(v) => {
-                log_once("RT_GL_MODE", &format!("RT_GL_MODE={v}: expected gl or rt; using gl"))
+                log_once("RT_GL_MODE", &format!("RT_GL_MODE={v}: expected gl, rt or off; using gl"))
             }
         }
         options.shadows = flag("RT_GL_SHADOWS", true);
@@ -142,6 +148,7 @@ impl Config {
             dump_raster: flag("RT_GL_DUMP_RASTER", false),
             stats: flag("RT_GL_STATS", false),
             asynchronous: flag("RT_GL_ASYNC", false),
+            off,
             pool,
         }
     }
@@ -178,9 +185,13 @@ pub(crate) fn catch<R>(f: impl FnOnce() -> R) -> Option<R> {
     }
 }
 
-/// Runs `f` on the process's recorder (`None` if it panicked).
+/// Runs `f` on the process's recorder (`None` if it panicked, or with
+/// `RT_GL_MODE=off`, where nothing is recorded).
 pub(crate) fn with_recorder<R>(f: impl FnOnce(&mut Recorder) -> R) -> Option<R> {
     static RECORDER: Mutex<Option<Recorder>> = Mutex::new(None);
+    if config().off {
+        return None;
+    }
     catch(|| {
         let mut r = RECORDER.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         f(r.get_or_insert_with(Recorder::new))

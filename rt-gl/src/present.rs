@@ -33,9 +33,19 @@ pub(crate) fn single_buffered_frame() {
 
 fn present_frame(buffer: u32) {
     let cfg = config();
+    if cfg.off {
+        let n = FRAME.fetch_add(1, Ordering::Relaxed);
+        if cfg.stats {
+            eprintln!("rt-gl: frame {n}: not traced (RT_GL_MODE=off)");
+        }
+        return;
+    }
     let Some(taken) = take(buffer) else {
         return;
     };
+    if cfg.stats {
+        eprintln!("rt-gl: frame {}: {:?}", taken.n, taken.counters);
+    }
     if cfg.asynchronous {
         let n = taken.n;
         let (counters, unsupported) = (taken.counters, taken.unsupported.clone());
@@ -125,7 +135,10 @@ fn take(buffer: u32) -> Option<Taken> {
         .map(|p| (resolve(p.view.viewport), p))
         .filter(|(v, _)| v[2] > 0 && v[3] > 0)
         .collect();
-    let window = clip_to_window(passes.iter().map(|(v, _)| *v).reduce(union)?);
+    // Pixel operations draw where the raster position is, in or out of
+    // the viewport.
+    let rects = passes.iter().flat_map(|(_, p)| p.draws.pixels.iter().map(|(r, _)| *r));
+    let window = clip_to_window(passes.iter().map(|(v, _)| *v).chain(rects).reduce(union)?);
     if window[2] <= 0 || window[3] <= 0 {
         return None;
     }
@@ -209,6 +222,8 @@ pub(crate) fn trace(taken: &Taken, sample: u32) -> Traced {
                 None => Content::Untraced,
             };
             traced += usize::from(matches!(content, Content::Traced { .. }));
+            let (viewport, content) =
+                with_pixels(viewport, content, &pass.draws.pixels, taken.window);
             Layer {
                 viewport,
                 depth_test: pass.view.depth_test,
@@ -271,9 +286,47 @@ fn show(
             log_once("dump", &format!("cannot write frame dumps to {}: {e}", dir.display()));
         }
     }
-    if cfg.stats {
-        eprintln!("rt-gl: frame {n}: {counters:?}");
+}
+
+/// A kept pass's coverage widened to the window rectangle `window` and
+/// joined by the rectangles its pixel operations drew, at their raster
+/// depths (they draw outside the viewport too).
+fn with_pixels(
+    viewport: [i32; 4],
+    content: Content,
+    pixels: &[([i32; 4], f32)],
+    window: [i32; 4],
+) -> ([i32; 4], Content) {
+    let Content::Raster { depth } = content else { return (viewport, content) };
+    if pixels.is_empty() {
+        return (viewport, Content::Raster { depth });
     }
+    let [wx, wy, ww, wh] = window;
+    let mut all = vec![f32::INFINITY; ww as usize * wh as usize];
+    let mut put = |x: i32, y: i32, z: f32| {
+        if x >= wx && y >= wy && x - wx < ww && y - wy < wh {
+            let i = (y - wy) as usize * ww as usize + (x - wx) as usize;
+            all[i] = all[i].min(z);
+        }
+    };
+    let [vx, vy, vw, _] = viewport;
+    for (i, &z) in depth.iter().enumerate() {
+        if z.is_finite() {
+            let (x, y) = ((i % vw as usize) as i32, (i / vw as usize) as i32);
+            put(vx + x, vy + y, z);
+        }
+    }
+    for &([x, y, w, h], z) in pixels {
+        // Clipped to the window first: a rectangle may be huge.
+        let (x0, y0) = (x.max(wx), y.max(wy));
+        let (x1, y1) = (x.saturating_add(w).min(wx + ww), y.saturating_add(h).min(wy + wh));
+        for py in y0..y1 {
+            for px in x0..x1 {
+                put(px, py, z);
+            }
+        }
+    }
+    (window, Content::Raster { depth: all })
 }
 
 /// Whether any of `p`'s draws is blended.

@@ -74,4 +74,22 @@ pub enum Command {
     AlphaFunc(u32, f32),
     /// `glDepthFunc(function)`.
     DepthFunc(u32),
+    /// `glRasterPos*` (object coordinates).
+    RasterPos(Vec4),
+    /// `glWindowPos*` (window coordinates and depth).
+    WindowPos(Vec3),
+    /// `glBitmap(width, height, xorig, yorig, xmove, ymove, …)`: the
+    /// rectangle it draws at the raster position (its bits are GL's to
+    /// draw), and the raster position's move.
+    Bitmap {
+        /// Width and height in pixels.
+        size: [i32; 2],
+        /// `(xorig, yorig)`.
+        origin: glam::Vec2,
+        /// `(xmove, ymove)`.
+        advance: glam::Vec2,
+    },
+    /// `glDrawPixels(width, height, …)`: the rectangle it draws at the
+    /// raster position.
+    DrawPixels([i32; 2]),
 }

@@ -86,13 +86,19 @@ pub struct FrameDraws {
     /// The texture objects at the frame's end, by name (what
     /// [`Shading::texture`] names).
     pub textures: Arc<HashMap<u32, Arc<Texture>>>,
+    /// Rectangles drawn by pixel operations (`glBitmap`, `glDrawPixels`)
+    /// in window coordinates `[x, y, width, height]`, with the raster
+    /// position's window depth: GL's pixels, kept where they win.
+    pub pixels: Vec<([i32; 4], f32)>,
 }
 
 impl FrameDraws {
     /// Whether nothing was drawn.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.immediate.is_empty() && self.instances.iter().all(|i| i.recorded.geometry().is_empty())
+        self.immediate.is_empty()
+            && self.pixels.is_empty()
+            && self.instances.iter().all(|i| i.recorded.geometry().is_empty())
     }
 
     /// Everything in eye space, in one piece.
@@ -120,9 +126,13 @@ pub struct View {
     pub viewport: [i32; 4],
     /// `GL_DEPTH_TEST` was on.
     pub depth_test: bool,
-    /// A texture target was enabled: the trace has no textures, so the
-    /// pass's pixels are GL's own (see [`View::is_kept`]).
+    /// Texturing the trace does not do was on (1-D, 3-D or cube-map
+    /// textures, generated coordinates): the pass's pixels are GL's own
+    /// (see [`View::is_kept`]).
     pub textured: bool,
+    /// The pass holds pixel operations (`glBitmap`, `glDrawPixels`),
+    /// whose pixels are GL's own.
+    pub pixels: bool,
 }
 
 impl View {
@@ -136,10 +146,11 @@ impl View {
     }
 
     /// Whether the pass is shown as GL drew it where it covers, not
-    /// traced: a 2-D overlay ([`View::is_overlay`]) or a textured pass.
+    /// traced: a 2-D overlay ([`View::is_overlay`]), a pass of pixel
+    /// operations or one textured as the trace cannot.
     #[must_use]
     pub fn is_kept(&self, viewport: [i32; 4]) -> bool {
-        self.textured || self.is_2d(viewport)
+        self.textured || self.pixels || self.is_2d(viewport)
     }
 
     fn is_2d(&self, viewport: [i32; 4]) -> bool {
@@ -203,6 +214,7 @@ impl Frame {
             all.lighting = d.lighting.or(all.lighting);
             all.fog = d.fog.or(all.fog);
             all.textures = d.textures;
+            all.pixels.extend(d.pixels);
         }
         all
     }

@@ -59,7 +59,10 @@ impl Overrides {
         let mut o = Self::default();
         for c in commands {
             match *c {
-                Command::Vertex(_) | Command::CallList(_) => break,
+                Command::Vertex(_)
+                | Command::CallList(_)
+                | Command::Bitmap { .. }
+                | Command::DrawPixels(_) => break,
                 Command::Normal(_) => o.normal = true,
                 Command::Color(_) => o.color = true,
                 Command::Material(gl::FRONT | gl::FRONT_AND_BACK, pname, _) => match pname {

@@ -49,6 +49,9 @@ pub struct Recorder {
     texgen: u8,
     /// `glDepthFunc`.
     depth_func: u32,
+    /// The current raster position: window coordinates and depth
+    /// (`None`: invalid, pixel operations draw nothing).
+    raster_pos: Option<Vec3>,
     /// `GL_ALPHA_TEST` and `glAlphaFunc`.
     alpha_test_on: bool,
     alpha_func: (u32, f32),
@@ -150,6 +153,7 @@ impl Recorder {
             texgen: 0,
             alpha_test_on: false,
             depth_func: gl::LESS,
+            raster_pos: Some(Vec3::ZERO),
             alpha_func: (gl::ALWAYS, 0.0),
             point_size: 1.0,
             line_width: 1.0,
@@ -226,7 +230,45 @@ impl Recorder {
             viewport: self.viewport,
             depth_test: self.depth_test,
             textured: self.untraced_texturing(),
+            pixels: false,
         }
+    }
+
+    /// Where a pixel operation (`glBitmap`, `glDrawPixels`) draws: a pass
+    /// of its own, kept as GL drew it.
+    fn pixel_rect(&mut self, rect: [i32; 4], depth: f32) {
+        let view = View { pixels: true, ..self.view() };
+        let split = self.frame.passes.last().is_none_or(|p| p.view != view || self.depth_cleared);
+        if split && self.frame.passes.len() < MAX_PASSES {
+            self.frame.passes.push(Pass {
+                view,
+                depth_cleared: core::mem::take(&mut self.depth_cleared),
+                background: self.background,
+                draws: FrameDraws::default(),
+            });
+        } else if split {
+            self.counters.passes_merged += 1;
+        }
+        if let Some(p) = self.frame.passes.last_mut() {
+            p.draws.pixels.push((rect, depth));
+        }
+    }
+
+    /// The window coordinates and depth of object point `v` under the
+    /// current matrices and viewport, if it is inside the clip volume
+    /// (`glRasterPos`).
+    fn window_of(&self, v: Vec4) -> Option<Vec3> {
+        let c = self.projection() * (self.modelview() * v);
+        let inside = c.w > 0.0 && c.truncate().abs().cmple(Vec3::splat(c.w)).all();
+        let [x, y, w, h] = self.viewport;
+        (inside && w > 0 && h > 0).then(|| {
+            let n = c.truncate() / c.w;
+            Vec3::new(
+                x as f32 + (n.x + 1.0) * 0.5 * w as f32,
+                y as f32 + (n.y + 1.0) * 0.5 * h as f32,
+                (n.z + 1.0) * 0.5,
+            )
+        })
     }
 
     /// The pass a draw made now goes into (`lit`, `fogged`: the draw is
@@ -499,6 +541,22 @@ impl Recorder {
                 }
             }
             Command::DepthFunc(func) => self.depth_func = func,
+            Command::RasterPos(v) => self.raster_pos = self.window_of(v),
+            Command::WindowPos(p) => self.raster_pos = Some(p),
+            Command::Bitmap { size: [w, h], origin, advance } => {
+                if let Some(p) = self.raster_pos {
+                    if w > 0 && h > 0 {
+                        let at = (p.truncate() - origin).floor();
+                        self.pixel_rect([at.x as i32, at.y as i32, w, h], p.z);
+                    }
+                    self.raster_pos = Some(p + advance.extend(0.0));
+                }
+            }
+            Command::DrawPixels([w, h]) => {
+                if let (Some(p), true) = (self.raster_pos, w > 0 && h > 0) {
+                    self.pixel_rect([p.x as i32, p.y as i32, w, h], p.z);
+                }
+            }
             Command::AlphaFunc(func, reference) => {
                 self.alpha_func = (func, reference.clamp(0.0, 1.0));
             }

@@ -51,6 +51,12 @@
  *                       and in front of the ball a quad whose RGBA
  *                       texture (linear, replacing the colour) has round
  *                       holes cut by the alpha test.
+ *                       With `bitmap`, the ball with bitmap text: a
+ *                       label at a 3-D raster position in front of it
+ *                       (glRasterPos3f, glBitmap glyphs moving the raster
+ *                       position), a line at a window position
+ *                       (glWindowPos2i), and a small image
+ *                       (glDrawPixels), all unlit.
  *
  * Build: cc -O2 -o private_gl private_gl.c -lX11 -ldl -lm
  */
@@ -200,6 +206,12 @@ int main(int argc, char **argv) {
     int wireframe = strcmp(mode, "wireframe") == 0;
     int still = strcmp(mode, "still") == 0;
     int texture = strcmp(mode, "texture") == 0;
+    int bitmap = strcmp(mode, "bitmap") == 0;
+    void (*rasterPos3f)(GLfloat, GLfloat, GLfloat) = (void *)need("glRasterPos3f");
+    void (*windowPos2i)(GLint, GLint) = (void *)need("glWindowPos2i");
+    void (*bitmapf)(GLsizei, GLsizei, GLfloat, GLfloat, GLfloat, GLfloat, const GLubyte *) =
+        (void *)need("glBitmap");
+    void (*drawPixels)(GLsizei, GLsizei, GLenum, GLenum, const void *) = (void *)need("glDrawPixels");
     void (*genTextures)(GLsizei, GLuint *) = (void *)need("glGenTextures");
     void (*bindTexture)(GLenum, GLuint) = (void *)need("glBindTexture");
     void (*texImage2D)(GLenum, GLint, GLint, GLsizei, GLsizei, GLint, GLenum, GLenum,
@@ -293,6 +305,53 @@ int main(int argc, char **argv) {
     enable(GL_COLOR_MATERIAL);
     GLfloat pos[4] = {1.0f, 2.0f, 3.0f, 0.0f};
     for (int f = 0; f < frames; f++) {
+        if (bitmap) {
+            /* A 16x16 glyph: a box with a diagonal, rows of 2 bytes. */
+            static GLubyte glyph[16][2];
+            for (int i = 0; i < 16; i++) {
+                unsigned bits = (i == 0 || i == 15) ? 0xFFFF : (0x8001 | (0x8000 >> i));
+                glyph[i][0] = (GLubyte)(bits >> 8);
+                glyph[i][1] = (GLubyte)bits;
+            }
+            static GLubyte image[12][12][4];
+            for (int i = 0; i < 12; i++)
+                for (int j = 0; j < 12; j++) {
+                    image[i][j][0] = (GLubyte)(20 * i);
+                    image[i][j][1] = (GLubyte)(20 * j);
+                    image[i][j][2] = 200;
+                    image[i][j][3] = 255;
+                }
+            clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+            matrixMode(GL_PROJECTION);
+            loadIdentity();
+            frustum(-0.6, 0.6, -0.6, 0.6, 1.0, 20.0);
+            matrixMode(GL_MODELVIEW);
+            loadIdentity();
+            lightfv(GL_LIGHT0, GL_POSITION, pos);
+            translatef(0.0f, 0.0f, -4.0f);
+            pushMatrix();
+            rotatef(20.0f * f, 0.3f, 1.0f, 0.0f);
+            p_color3f(0.9f, 0.5f, 0.2f);
+            ball();
+            popMatrix();
+            disable(GL_LIGHTING);
+            pixelStorei(GL_UNPACK_ALIGNMENT, 1);
+            /* The label, in front of the ball's centre. */
+            color3f(0.2f, 1.0f, 0.4f);
+            rasterPos3f(-0.5f, 0.0f, 1.5f);
+            for (int k = 0; k < 4; k++) bitmapf(16, 16, 0.0f, 0.0f, 18.0f, 0.0f, &glyph[0][0]);
+            /* A line of glyphs near the window's bottom, moving. */
+            color3f(1.0f, 1.0f, 0.3f);
+            windowPos2i(10 + 4 * f, 10);
+            for (int k = 0; k < 6; k++) bitmapf(16, 16, 0.0f, 0.0f, 20.0f, 0.0f, &glyph[0][0]);
+            windowPos2i(200, 220);
+            drawPixels(12, 12, GL_RGBA, GL_UNSIGNED_BYTE, image);
+            pixelStorei(GL_UNPACK_ALIGNMENT, 4);
+            enable(GL_LIGHTING);
+            swapBuffers(dpy, win);
+            finish();
+            continue;
+        }
         if (texture) {
             clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
             matrixMode(GL_PROJECTION);

@@ -26,6 +26,7 @@ mod distributed;
 mod embree3;
 mod focusing;
 mod gl;
+mod gl_programs;
 mod grin;
 mod noise;
 mod octree;
