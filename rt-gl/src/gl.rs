@@ -87,6 +87,13 @@ pub const LEQUAL: u32 = 0x0203;
 pub const NOTEQUAL: u32 = 0x0205;
 pub const GEQUAL: u32 = 0x0206;
 pub const ALWAYS: u32 = 0x0207;
+pub const S: u32 = 0x2000;
+pub const TEXTURE_GEN_MODE: u32 = 0x2500;
+pub const OBJECT_PLANE: u32 = 0x2501;
+pub const EYE_PLANE: u32 = 0x2502;
+pub const EYE_LINEAR: u32 = 0x2400;
+pub const OBJECT_LINEAR: u32 = 0x2401;
+pub const SPHERE_MAP: u32 = 0x2402;
 pub const BACK_BUFFER: u32 = 0x0405;
 pub const VIEWPORT: u32 = 0x0BA2;
 

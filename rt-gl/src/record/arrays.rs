@@ -521,7 +521,8 @@ impl Recorder {
     unsafe fn draw(&mut self, mode: u32, idx: Indices) {
         let points_or_lines =
             matches!(mode, gl::POINTS | gl::LINES | gl::LINE_LOOP | gl::LINE_STRIP)
-                || self.polygon_mode != [gl::FILL; 2];
+                || self.polygon_mode != [gl::FILL; 2]
+                || self.view_dependent_texgen();
         let plain = self.compiling.is_none()
             && self.state_only == 0
             && self.capture.is_none()

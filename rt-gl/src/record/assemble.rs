@@ -13,16 +13,16 @@ pub(super) type Vert = (Vec3, Vec3, Vec4, Vec2);
 impl Recorder {
     pub(super) fn vertex(&mut self, v: Vec4) {
         let mv = self.modelview();
-        let t = self.texture_matrix() * self.texcoord;
+        let e = mv * v;
+        let n = normal_matrix(&mv) * self.normal;
+        let t = self.texture_matrix() * self.generated_texcoord(v, e, n);
         let Some((_, verts)) = &mut self.begin else {
             self.counters.ignored += 1;
             return;
         };
-        let e = mv * v;
         if e.w == 0.0 || !e.is_finite() {
             return;
         }
-        let n = normal_matrix(&mv) * self.normal;
         let uv = if t.w == 0.0 { Vec2::ZERO } else { Vec2::new(t.x, t.y) / t.w };
         verts.push((e.truncate() / e.w, n, self.color, uv));
     }

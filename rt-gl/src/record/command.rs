@@ -74,6 +74,8 @@ pub enum Command {
     AlphaFunc(u32, f32),
     /// `glDepthFunc(function)`.
     DepthFunc(u32),
+    /// `glTexGen*(coord, pname, value)` (scalars in `value[0]`).
+    TexGen(u32, u32, Vec4),
     /// `glRasterPos*` (object coordinates).
     RasterPos(Vec4),
     /// `glWindowPos*` (window coordinates and depth).

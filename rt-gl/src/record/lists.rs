@@ -158,6 +158,8 @@ impl Recorder {
                     | Command::MatrixMode(_)
                     | Command::Begin(gl::POINTS | gl::LINES | gl::LINE_LOOP | gl::LINE_STRIP)
                     | Command::PolygonMode(_, gl::LINE | gl::POINT)
+                    | Command::TexGen(..)
+                    | Command::Enable(0x0C60..=0x0C63)
             )
         });
         let nested = commands.iter().any(|c| matches!(c, Command::CallList(_)));
@@ -172,6 +174,7 @@ impl Recorder {
                     | Command::TexEnv(..)
                     | Command::AlphaFunc(..)
                     | Command::DepthFunc(_)
+                    | Command::TexGen(..)
                     | Command::BlendFunc(..)
                     | Command::CullFace(_)
                     | Command::ColorMask(_)
@@ -238,7 +241,12 @@ impl Recorder {
         match Self::to_local(&mv) {
             // Polygons drawn as lines or points are sized in pixels at
             // their depth, as lines are: not recordable once.
-            Some(to_local) if plain && list.cacheable && self.polygon_mode == [gl::FILL; 2] => {
+            Some(to_local)
+                if plain
+                    && list.cacheable
+                    && self.polygon_mode == [gl::FILL; 2]
+                    && !self.view_dependent_texgen() =>
+            {
                 let mut key = list.overrides.mask(self.inherited(if list.nested {
                     self.generation
                 } else {

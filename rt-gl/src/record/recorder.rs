@@ -46,7 +46,12 @@ pub struct Recorder {
     /// `glPixelStore`'s unpack state.
     pub unpack: PixelStore,
     unit0: bool,
+    /// `GL_TEXTURE_GEN_S`…`_Q` on (a bit each), their modes, object and
+    /// eye planes (eye planes as GL keeps them: times the inverse
+    /// modelview at the call).
     texgen: u8,
+    pub(super) texgen_mode: [u32; 4],
+    pub(super) texgen_planes: [[Vec4; 2]; 4],
     /// `glDepthFunc`.
     depth_func: u32,
     /// The current raster position: window coordinates and depth
@@ -151,6 +156,13 @@ impl Recorder {
             unpack: PixelStore::default(),
             unit0: true,
             texgen: 0,
+            texgen_mode: [gl::EYE_LINEAR; 4],
+            texgen_planes: [
+                [Vec4::X, Vec4::X],
+                [Vec4::Y, Vec4::Y],
+                [Vec4::ZERO, Vec4::ZERO],
+                [Vec4::ZERO, Vec4::ZERO],
+            ],
             alpha_test_on: false,
             depth_func: gl::LESS,
             raster_pos: Some(Vec3::ZERO),
@@ -541,6 +553,23 @@ impl Recorder {
                 }
             }
             Command::DepthFunc(func) => self.depth_func = func,
+            Command::TexGen(coord, pname, v) => {
+                let Some(i) = coord.checked_sub(gl::S).filter(|&i| i < 4 && self.unit0) else {
+                    self.counters.ignored += 1;
+                    return;
+                };
+                let i = i as usize;
+                match pname {
+                    gl::TEXTURE_GEN_MODE => self.texgen_mode[i] = v.x as u32,
+                    gl::OBJECT_PLANE => self.texgen_planes[i][0] = v,
+                    gl::EYE_PLANE => {
+                        // GL: (p1 p2 p3 p4) times the inverse modelview.
+                        let inv = Self::to_local(&self.modelview()).unwrap_or(Mat4::IDENTITY);
+                        self.texgen_planes[i][1] = inv.transpose() * v;
+                    }
+                    _ => self.counters.ignored += 1,
+                }
+            }
             Command::RasterPos(v) => self.raster_pos = self.window_of(v),
             Command::WindowPos(p) => self.raster_pos = Some(p),
             Command::Bitmap { size: [w, h], origin, advance } => {
@@ -579,7 +608,51 @@ impl Recorder {
     fn untraced_texturing(&self) -> bool {
         let on_2d = self.texture_targets & 2 != 0;
         let unread = || self.textures.get(&self.bound_texture).is_some_and(|t| !t.readable);
-        self.texture_targets & !2 != 0 || (on_2d && (self.texgen != 0 || unread()))
+        // Normal and reflection maps (cube-map coordinates) are not made.
+        let odd_gen = (0..4).any(|i| {
+            self.texgen & (1 << i) != 0
+                && !matches!(
+                    self.texgen_mode[i],
+                    gl::OBJECT_LINEAR | gl::EYE_LINEAR | gl::SPHERE_MAP
+                )
+        });
+        self.texture_targets & !2 != 0 || (on_2d && (odd_gen || unread()))
+    }
+
+    /// Whether texture coordinates depend on where a draw is seen from
+    /// (`glTexGen` eye-linear or sphere-map): such draws are not cached
+    /// in entry space.
+    pub(super) fn view_dependent_texgen(&self) -> bool {
+        (0..4).any(|i| self.texgen & (1 << i) != 0 && self.texgen_mode[i] != gl::OBJECT_LINEAR)
+    }
+
+    /// The texture coordinates of a vertex at object position `v`, eye
+    /// position `e` and eye normal `n`: the current ones, with those
+    /// `glTexGen` generates in their place (GL 2.1 §2.12.4).
+    pub(super) fn generated_texcoord(&self, v: Vec4, e: Vec4, n: Vec3) -> Vec4 {
+        let mut t = self.texcoord;
+        if self.texgen == 0 {
+            return t;
+        }
+        let sphere = || {
+            let u = (e.truncate() / e.w).normalize_or_zero();
+            let n = n.normalize_or_zero();
+            let r = u - 2.0 * n.dot(u) * n;
+            let m = 2.0 * (r.x * r.x + r.y * r.y + (r.z + 1.0) * (r.z + 1.0)).sqrt();
+            if m > 0.0 { [r.x / m + 0.5, r.y / m + 0.5] } else { [0.5, 0.5] }
+        };
+        for i in 0..4 {
+            if self.texgen & (1 << i) == 0 {
+                continue;
+            }
+            t[i] = match self.texgen_mode[i] {
+                gl::OBJECT_LINEAR => self.texgen_planes[i][0].dot(v),
+                gl::EYE_LINEAR => self.texgen_planes[i][1].dot(e),
+                gl::SPHERE_MAP if i < 2 => sphere()[i],
+                _ => t[i],
+            };
+        }
+        t
     }
 
     /// The 2-D texture a draw made now is textured with.
@@ -787,7 +860,6 @@ impl Recorder {
 fn unsupported_cap(cap: u32) -> Option<&'static str> {
     Some(match cap {
         0x0DE0 => "GL_TEXTURE_1D",
-        0x0C60..=0x0C63 => "GL_TEXTURE_GEN",
         0x806F => "GL_TEXTURE_3D",
         0x8513 => "GL_TEXTURE_CUBE_MAP",
         0x0B90 => "GL_STENCIL_TEST",

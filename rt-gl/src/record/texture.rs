@@ -6,10 +6,12 @@
 //! `GL_ADD`).
 //!
 //! Approximated: only level 0 is kept, so a minified texture is sampled
-//! as its `GL_*_MIPMAP_*` filter's base (nearest or linear) rather than
-//! from the mipmap GL would pick; texture coordinate generation
-//! (`glTexGen`), 1-D, 3-D and cube-map textures are not traced (a pass
-//! drawn with them is kept as GL drew it).
+//! with the magnification filter rather than from the mipmap GL would
+//! pick (a ray has no pixel footprint); `glTexGen`'s normal and
+//! reflection maps, 1-D, 3-D and cube-map textures are not traced (a
+//! pass drawn with them is kept as GL drew it). Object-linear,
+//! eye-linear and sphere-map coordinates are generated per vertex, as GL
+//! does (`Recorder::generated_texcoord`).
 
 use glam::{Vec2, Vec4};
 

@@ -51,6 +51,8 @@
  *                       and in front of the ball a quad whose RGBA
  *                       texture (linear, replacing the colour) has round
  *                       holes cut by the alpha test.
+ *                       With `texgen`, the checkerboard sphere-mapped on
+ *                       the turning ball, and object-linear on a quad.
  *                       With `bitmap`, the ball with bitmap text: a
  *                       label at a 3-D raster position in front of it
  *                       (glRasterPos3f, glBitmap glyphs moving the raster
@@ -207,6 +209,9 @@ int main(int argc, char **argv) {
     int still = strcmp(mode, "still") == 0;
     int texture = strcmp(mode, "texture") == 0;
     int bitmap = strcmp(mode, "bitmap") == 0;
+    int texgen = strcmp(mode, "texgen") == 0;
+    void (*texGeni)(GLenum, GLenum, GLint) = (void *)need("glTexGeni");
+    void (*texGenfv)(GLenum, GLenum, const GLfloat *) = (void *)need("glTexGenfv");
     void (*rasterPos3f)(GLfloat, GLfloat, GLfloat) = (void *)need("glRasterPos3f");
     void (*windowPos2i)(GLint, GLint) = (void *)need("glWindowPos2i");
     void (*bitmapf)(GLsizei, GLsizei, GLfloat, GLfloat, GLfloat, GLfloat, const GLubyte *) =
@@ -222,7 +227,7 @@ int main(int argc, char **argv) {
     void (*alphaFunc)(GLenum, GLclampf) = (void *)need("glAlphaFunc");
     void (*pixelStorei)(GLenum, GLint) = (void *)need("glPixelStorei");
     GLuint tex[2] = {0, 0};
-    if (texture) {
+    if (texture || texgen) {
         /* An 8x8 RGB checkerboard, rows of 3 bytes: unpack alignment 1. */
         static GLubyte checker[8][8][3];
         for (int i = 0; i < 8; i++)
@@ -348,6 +353,53 @@ int main(int argc, char **argv) {
             drawPixels(12, 12, GL_RGBA, GL_UNSIGNED_BYTE, image);
             pixelStorei(GL_UNPACK_ALIGNMENT, 4);
             enable(GL_LIGHTING);
+            swapBuffers(dpy, win);
+            finish();
+            continue;
+        }
+        if (texgen) {
+            clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+            matrixMode(GL_PROJECTION);
+            loadIdentity();
+            frustum(-0.6, 0.6, -0.6, 0.6, 1.0, 20.0);
+            matrixMode(GL_MODELVIEW);
+            loadIdentity();
+            lightfv(GL_LIGHT0, GL_POSITION, pos);
+            enable(GL_TEXTURE_2D);
+            bindTexture(GL_TEXTURE_2D, tex[0]);
+            texParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            texEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+            /* The ball, sphere-mapped. */
+            texGeni(GL_S, GL_TEXTURE_GEN_MODE, GL_SPHERE_MAP);
+            texGeni(GL_T, GL_TEXTURE_GEN_MODE, GL_SPHERE_MAP);
+            enable(GL_TEXTURE_GEN_S);
+            enable(GL_TEXTURE_GEN_T);
+            pushMatrix();
+            translatef(0.5f, 0.3f, -5.0f);
+            rotatef(20.0f * f, 0.3f, 1.0f, 0.0f);
+            p_color3f(1.0f, 1.0f, 1.0f);
+            ball();
+            popMatrix();
+            /* A quad, object-linear: s = x, t = y. */
+            const GLfloat sp[4] = {1.0f, 0.0f, 0.0f, 0.0f}, tp[4] = {0.0f, 1.0f, 0.0f, 0.0f};
+            texGeni(GL_S, GL_TEXTURE_GEN_MODE, GL_OBJECT_LINEAR);
+            texGeni(GL_T, GL_TEXTURE_GEN_MODE, GL_OBJECT_LINEAR);
+            texGenfv(GL_S, GL_OBJECT_PLANE, sp);
+            texGenfv(GL_T, GL_OBJECT_PLANE, tp);
+            pushMatrix();
+            translatef(-1.2f, -1.0f, -5.0f);
+            rotatef(15.0f * f, 0.0f, 1.0f, 0.0f);
+            begin(GL_QUADS);
+            normal3f(0.0f, 0.0f, 1.0f);
+            vertex3f(-0.8f, -0.8f, 0.0f);
+            vertex3f(0.8f, -0.8f, 0.0f);
+            vertex3f(0.8f, 0.8f, 0.0f);
+            vertex3f(-0.8f, 0.8f, 0.0f);
+            end();
+            popMatrix();
+            disable(GL_TEXTURE_GEN_S);
+            disable(GL_TEXTURE_GEN_T);
+            disable(GL_TEXTURE_2D);
             swapBuffers(dpy, win);
             finish();
             continue;

@@ -109,7 +109,7 @@ fn programs(dir: &Path, secs: &str) -> Result<Vec<Program>, String> {
     let egl = compile(dir, "egl_gl", &["-lEGL", "-lGL", "-lX11", "-lm"])?;
     let scenes = compile(dir, "scenes", &["-lGL", "-lX11", "-lm"])?;
     let mut v = Vec::new();
-    let modes: [(&str, &str); 14] = [
+    let modes: [(&str, &str); 16] = [
         ("", "libGL opened privately, glXGetProcAddressARB"),
         ("noviewport", "no glViewport"),
         ("cw", "glFrontFace(GL_CW), two-sided lighting"),
@@ -123,6 +123,8 @@ fn programs(dir: &Path, secs: &str) -> Result<Vec<Program>, String> {
         ("blend", "alpha blending, culling, GL_NORMALIZE"),
         ("wireframe", "glPolygonMode(GL_LINE)"),
         ("texture", "2-D textures, environments, alpha test"),
+        ("texgen", "glTexGen sphere map, object linear"),
+        ("bitmap", "glBitmap text, glDrawPixels"),
         ("still", "a still ball (asynchronous accumulation)"),
     ];
     for (mode, what) in modes {
