@@ -5,6 +5,7 @@
 use proptest::prelude::*;
 use rt_core::glam::{Mat4, Vec3, Vec4};
 use rt_gl::{
+    composite::{Content, Layer, composite},
     gl,
     record::{Command, GeometryError, Recorder, arrays},
     render::{FrameScene, Illumination, Options, RenderError},
@@ -44,6 +45,17 @@ fn glenum() -> impl Strategy<Value = u32> {
         Just(gl::POSITION),
         Just(gl::SPOT_CUTOFF),
         Just(gl::FLAT),
+        Just(gl::TEXTURE_2D),
+        Just(gl::FOG),
+        Just(gl::BLEND),
+        Just(gl::ALPHA_TEST),
+        Just(gl::CULL_FACE),
+        Just(gl::DEPTH_TEST),
+        Just(gl::SCISSOR_TEST),
+        Just(0x0C60u32),
+        Just(gl::SPHERE_MAP),
+        Just(gl::OBJECT_PLANE),
+        Just(gl::LINE),
         any::<u32>(),
     ]
 }
@@ -71,6 +83,25 @@ fn command() -> impl Strategy<Value = Command> {
         float().prop_map(Command::PointSize),
         float().prop_map(Command::LineWidth),
         (0u32..4).prop_map(Command::CallList),
+        (glenum(), glenum()).prop_map(|(f, m)| Command::PolygonMode(f, m)),
+        (glenum(), vec4()).prop_map(|(p, v)| Command::Fog(p, v)),
+        (glenum(), glenum()).prop_map(|(s, d)| Command::BlendFunc(s, d)),
+        glenum().prop_map(Command::CullFace),
+        any::<bool>().prop_map(Command::ColorMask),
+        vec4().prop_map(Command::TexCoord),
+        (glenum(), 0u32..3).prop_map(|(t, n)| Command::BindTexture(t, n)),
+        (glenum(), vec4()).prop_map(|(p, v)| Command::TexEnv(p, v)),
+        (glenum(), float()).prop_map(|(f, r)| Command::AlphaFunc(f, r)),
+        glenum().prop_map(Command::DepthFunc),
+        (0x2000u32..0x2005, glenum(), vec4()).prop_map(|(c, p, v)| Command::TexGen(c, p, v)),
+        vec4().prop_map(Command::RasterPos),
+        vec4().prop_map(|v| Command::WindowPos(v.truncate())),
+        (-4i32..70000, -4i32..70000, vec4()).prop_map(|(w, h, v)| Command::Bitmap {
+            size: [w, h],
+            origin: v.truncate().truncate(),
+            advance: v.truncate().truncate() * 3.0,
+        }),
+        (-4i32..70000, -4i32..70000).prop_map(|(w, h)| Command::DrawPixels([w, h])),
     ]
 }
 
@@ -83,6 +114,9 @@ enum Step {
     DeleteLists(u32, i32),
     Buffer(Vec<f32>),
     Draw(u32, i32, i32),
+    /// `glTexImage2D` of the bound texture: size, format, type, bytes.
+    TexImage(i32, i32, u32, u32, Vec<u8>),
+    Clear(u32),
     EndFrame,
 }
 
@@ -95,11 +129,41 @@ fn step() -> impl Strategy<Value = Step> {
         1 => (0u32..4, -2i32..4).prop_map(|(f, r)| Step::DeleteLists(f, r)),
         1 => prop::collection::vec(float(), 0..30).prop_map(Step::Buffer),
         2 => (glenum(), -2i32..12, -2i32..40).prop_map(|(m, f, c)| Step::Draw(m, f, c)),
+        1 => (-2i32..20, -2i32..20, prop_oneof![Just(gl::RGB), Just(gl::RGBA), Just(0x1909u32), any::<u32>()],
+              prop_oneof![Just(gl::UNSIGNED_BYTE), Just(gl::FLOAT), any::<u32>()],
+              prop::collection::vec(any::<u8>(), 0..2000))
+            .prop_map(|(w, h, f, t, d)| Step::TexImage(w, h, f, t, d)),
+        1 => prop_oneof![Just(0x4100u32), Just(0x100u32), Just(0x4000u32), any::<u32>()].prop_map(Step::Clear),
         1 => Just(Step::EndFrame),
     ]
 }
 
 fn trace(r: &Recorder, mode: Illumination) {
+    // Each pass under its own view, composited as the interposer does.
+    let mut layers = Vec::new();
+    for p in &r.frame().passes {
+        let Ok(scene) = FrameScene::build(p.draws.clone()) else { continue };
+        let v = p.view.viewport.map(|x| x.clamp(0, 16));
+        let (w, h) = (v[2].max(1) as u32, v[3].max(1) as u32);
+        let opts = Options { mode, ao_samples: 2, ..Options::default() };
+        let content = if p.view.is_kept(v) {
+            scene.coverage(p.view.projection, w, h).map(|depth| Content::Raster { depth })
+        } else {
+            scene
+                .render_sample(&r.lighting, p.view.projection, w, h, p.background, &opts, 1)
+                .map(|(image, depth)| Content::Traced { image, depth })
+        };
+        let content = content.unwrap_or(Content::Untraced);
+        let viewport = [v[0], v[1], w as i32, h as i32];
+        layers.push(Layer {
+            viewport,
+            depth_test: p.view.depth_test,
+            depth_cleared: p.depth_cleared,
+            background: p.background,
+            content,
+        });
+    }
+    let _ = composite([0, 0, 20, 20], &layers, None);
     let frame = r.frame().clone().draws();
     // What the recorder makes is always well formed.
     assert_eq!(frame.immediate.check(), Ok(()));
@@ -152,6 +216,14 @@ proptest! {
                 // SAFETY: the only array enabled lives in buffer 1, read
                 // with bounds checks.
                 Step::Draw(m, f, c) => unsafe { r.draw_arrays(m, f, c) },
+                Step::TexImage(w, h, f, t, d) => {
+                    let data = (!d.is_empty()).then_some(d.as_slice());
+                    r.tex_image_2d(gl::TEXTURE_2D, 0, f, [w, h], f, t, data);
+                    if let Some(d) = data {
+                        r.tex_sub_image_2d(gl::TEXTURE_2D, 0, [1, 1], [w / 2, h / 2], f, t, Some(d));
+                    }
+                }
+                Step::Clear(mask) => r.clear(mask),
                 Step::EndFrame => {
                     trace(&r, mode);
                     let _ = r.end_frame();
@@ -164,6 +236,9 @@ proptest! {
         r.end_list();
         r.command(Command::End);
         let _ = r.end_frame();
+        // What a program would set back: colour written, polygons filled.
+        r.command(Command::ColorMask(true));
+        r.command(Command::PolygonMode(gl::FRONT_AND_BACK, gl::FILL));
         r.command(Command::MatrixMode(gl::MODELVIEW));
         r.command(Command::LoadIdentity);
         r.command(Command::Begin(gl::TRIANGLES));

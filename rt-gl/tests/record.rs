@@ -532,3 +532,38 @@ fn mutually_recursive_lists_stop_at_the_budget() {
     r.command(Command::CallList(2));
     assert!(!r.end_frame().is_empty());
 }
+
+/// `glTexImage2D` reads client images as the unpack state lays them out
+/// (GL 2.1 §3.6.1): rows padded to `GL_UNPACK_ALIGNMENT`, a longer row
+/// length, skipped rows and pixels; luminance is spread over RGB and
+/// alpha is 1 where the format has none.
+#[test]
+fn texture_images_are_unpacked_as_gl_reads_them() {
+    use rt_gl::record::texture::Texture;
+    let mut r = Recorder::new();
+    r.command(Command::BindTexture(gl::TEXTURE_2D, 5));
+    // 3 × 2 RGB bytes at the default alignment 4: rows of 9 bytes padded
+    // to 12; the pad bytes (99) must never be read.
+    let rgb: Vec<u8> =
+        [[1, 2, 3, 4, 5, 6, 7, 8, 9, 99, 99, 99], [10, 11, 12, 13, 14, 15, 16, 17, 18, 99, 99, 99]]
+            .concat();
+    r.tex_image_2d(gl::TEXTURE_2D, 0, gl::RGB, [3, 2], gl::RGB, gl::UNSIGNED_BYTE, Some(&rgb));
+    let t: &Texture = &r.textures()[&5];
+    assert_eq!(t.texels[2], [7, 8, 9, 255]);
+    assert_eq!(t.texels[3], [10, 11, 12, 255]);
+    // Row length 4 (pixels), skip one row and one pixel, alignment 1:
+    // a 2 × 1 luminance image out of a 4 × 2 buffer.
+    r.pixel_store(0x0CF5, 1);
+    r.pixel_store(0x0CF2, 4);
+    r.pixel_store(0x0CF3, 1);
+    r.pixel_store(0x0CF4, 1);
+    let lum = [0u8, 1, 2, 3, 40, 50, 60, 70];
+    r.tex_image_2d(gl::TEXTURE_2D, 0, 0x1909, [2, 1], 0x1909, gl::UNSIGNED_BYTE, Some(&lum));
+    let t = &r.textures()[&5];
+    assert_eq!(t.texels, vec![[50, 50, 50, 255], [60, 60, 60, 255]]);
+    // An image shorter than its layout is not read: the texture is not
+    // known, and the draws textured with it are left to GL.
+    r.tex_image_2d(gl::TEXTURE_2D, 0, gl::RGB, [3, 2], gl::RGB, gl::UNSIGNED_BYTE, Some(&rgb[..5]));
+    assert!(!r.textures()[&5].readable);
+    assert_eq!(r.unsupported.get("glTexImage2D.unread_format"), Some(&1));
+}

@@ -701,11 +701,23 @@ impl Recorder {
             return;
         }
         let unpack = self.unpack;
+        let n = width as usize * height as usize;
+        let mut texels = Vec::new();
+        // The host program must not be aborted by a copy it never asked
+        // for: a texture too large to shadow is left to GL.
+        let fits = texels.try_reserve_exact(n).is_ok();
         let t = self.bound_2d();
         t.width = width as u32;
         t.height = height as u32;
         t.format = BaseFormat::of(internal);
-        t.texels = vec![[255; 4]; width as usize * height as usize];
+        if !fits {
+            t.readable = false;
+            t.texels = Vec::new();
+            self.unsupported("glTexImage2D.too_large");
+            return;
+        }
+        texels.resize(n, [255; 4]);
+        t.texels = texels;
         let size = [width as usize, height as usize];
         // No data: texels GL leaves undefined, for glTexSubImage2D.
         t.readable = data.is_none_or(|d| t.store([0, 0], size, format, ty, d, &unpack));
@@ -761,6 +773,12 @@ impl Recorder {
             }
             _ => {}
         }
+    }
+
+    /// The texture objects by name (level 0 and parameters).
+    #[must_use]
+    pub fn textures(&self) -> &HashMap<u32, Arc<Texture>> {
+        &self.textures
     }
 
     /// `glDeleteTextures`.
