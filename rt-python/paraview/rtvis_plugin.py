@@ -45,6 +45,12 @@ def _enum(name, command, entries, default, doc):
     )
 
 
+def _doc(text):
+    """The property's tooltip (ParaView shows a property's Documentation
+    as its tooltip); units in it."""
+    return smdomain.xml(f"<Documentation>{text}</Documentation>")
+
+
 def _array_selection(name, attribute, doc):
     return smproperty.xml(
         f'<StringVectorProperty name="{name}" command="SetInputArrayToProcess" number_of_elements="5" '
@@ -95,7 +101,7 @@ def _world():
     return comm.Get_rank(), comm.Get_size(), comm
 
 
-@smproxy.filter(name="RTSchlieren")
+@smproxy.filter(name="RTSchlieren", label="RT Schlieren")
 @smhint.xml('<ShowInMenu category="rt"/>')
 @smproperty.input(name="Input", port_index=0)
 @smdomain.datatype(dataTypes=["vtkImageData"], composite_data_supported=False)
@@ -113,6 +119,7 @@ class RTSchlieren(VTKPythonAlgorithmBase):
         self._quantity, self._k, self._cutoff, self._angle = 0, 2.26e-4, 0, 0.0
         self._f, self._h, self._film, self._wavelength, self._fringes = 1.0, 0.0, 0.0, 10.6e-6, 0.0
         self._axis, self._size, self._photons, self._seed, self._cubic = 2, 512, 16, 1, 1
+        self._nonphysical = 0
 
     def _set(self, name, value):
         if getattr(self, name) != value:
@@ -130,6 +137,7 @@ class RTSchlieren(VTKPythonAlgorithmBase):
 
     @smproperty.doublevector(name="K", default_values=[2.26e-4])
     @smdomain.doublerange(min=0.0)
+    @_doc("Gladstone–Dale constant K in m³/kg (n = 1 + K·ρ); 2.26e-4 is air at visible wavelengths. Used for density only.")
     def SetK(self, v):
         self._set("_k", float(v))
 
@@ -139,28 +147,34 @@ class RTSchlieren(VTKPythonAlgorithmBase):
         self._set("_cutoff", int(v))
 
     @smproperty.doublevector(name="Angle", default_values=[0.0])
+    @_doc("Knife-edge (or graded filter) orientation in degrees, counter-clockwise from the image's +x axis.")
     def SetAngle(self, v):
         self._set("_angle", float(v))
 
     @smproperty.doublevector(name="FocalLength", default_values=[1.0])
+    @_doc("Focal length of the schlieren head in metres: the cutoff sees deflection × focal length.")
     def SetFocalLength(self, v):
         self._set("_f", float(v))
 
     @smproperty.doublevector(name="SourceHeight", default_values=[0.0])
+    @_doc("Unobstructed source height at the cutoff in metres (knife edge, graded filter; the pinhole's and dark field's radius). 0: chosen from the data (automatic exposure).")
     def SetSourceHeight(self, v):
         self._set("_h", float(v))
 
     @smproperty.doublevector(name="FilmDistance",
                              default_values=[0.0])
+    @_doc("Distance in metres from the test section to the film: the shadowgraph's (0: chosen from the data), or the schlieren film's defocus (0: focused on the test section).")
     def SetFilmDistance(self, v):
         self._set("_film", float(v))
 
     @smproperty.doublevector(name="Wavelength", default_values=[10.6e-6])
+    @_doc("Wavelength in metres (interferometry). 10.6e-6 is a CO₂ laser.")
     def SetWavelength(self, v):
         self._set("_wavelength", float(v))
 
     @smproperty.doublevector(name="FringeSpacing",
                              default_values=[0.0])
+    @_doc("Spacing of the reference fringes in metres (interferometry). 0: chosen from the data.")
     def SetFringeSpacing(self, v):
         self._set("_fringes", float(v))
 
@@ -170,15 +184,18 @@ class RTSchlieren(VTKPythonAlgorithmBase):
 
     @smproperty.intvector(name="Size", default_values=[512])
     @smdomain.intrange(min=1, max=16384)
+    @_doc("Image width in pixels (the height follows the volume's aspect).")
     def SetSize(self, v):
         self._set("_size", int(v))
 
     @smproperty.intvector(name="Photons", default_values=[16])
     @smdomain.intrange(min=1, max=65536)
+    @_doc("Photons traced per pixel (jittered): more is smoother, time grows with it.")
     def SetPhotons(self, v):
         self._set("_photons", int(v))
 
     @smproperty.intvector(name="Seed", default_values=[1])
+    @_doc("Random seed of the photon jitter: the same seed gives the same image, bit for bit, at any thread count.")
     def SetSeed(self, v):
         self._set("_seed", int(v))
 
@@ -187,6 +204,12 @@ class RTSchlieren(VTKPythonAlgorithmBase):
            "trilinear is about twice as fast but its gradient jumps at cell faces.")
     def SetInterpolation(self, v):
         self._set("_cubic", int(v))
+
+    @smproperty.intvector(name="AllowNonphysical", default_values=[0])
+    @smdomain.xml('<BooleanDomain name="bool"/>')
+    @_doc("Accept samples no gas has (negative density, an index below 1) instead of refusing the volume.")
+    def SetAllowNonphysical(self, v):
+        self._set("_nonphysical", int(v))
 
     def _geometry(self, in_info):
         """(dims, origin, spacing) of the samples: points, or cell centres
@@ -229,9 +252,14 @@ class RTSchlieren(VTKPythonAlgorithmBase):
         if array is None:
             raise ValueError("RT Schlieren: choose a scalar array (Array)")
         values = numpy_support.vtk_to_numpy(array).reshape(dims[2], dims[1], dims[0])
-        vol = rtvis.Volume(values, spacing=tuple(spacing), origin=tuple(origin),
-                           quantity=["density", "index"][self._quantity], k=self._k,
-                           interpolation=["linear", "cubic"][self._cubic])
+        try:
+            vol = rtvis.Volume(values, spacing=tuple(spacing), origin=tuple(origin),
+                               quantity=["density", "index"][self._quantity], k=self._k,
+                               interpolation=["linear", "cubic"][self._cubic],
+                               allow_nonphysical=bool(self._nonphysical))
+        except ValueError as e:
+            # rtvis names its keywords; here they are properties.
+            raise ValueError(f"RT Schlieren: {e} (here: check Quantity, or tick Allow Nonphysical)") from e
         cutoff = _CUTOFFS[self._cutoff]
         common = dict(axis=_AXES[self._axis], size=self._size, photons=self._photons, seed=self._seed,
                       deflection=True)
@@ -257,7 +285,7 @@ class RTSchlieren(VTKPythonAlgorithmBase):
         return 1
 
 
-@smproxy.filter(name="RTSurfaceRender")
+@smproxy.filter(name="RTSurfaceRender", label="RT Surface Render")
 @smhint.xml('<ShowInMenu category="rt"/>')
 @smproperty.input(name="Input", port_index=0)
 @smdomain.datatype(dataTypes=["vtkDataSet"], composite_data_supported=False)
@@ -290,6 +318,7 @@ class RTSurfaceRender(VTKPythonAlgorithmBase):
 
     @smproperty.intvector(name="ColorByArray", default_values=[1])
     @smdomain.xml('<BooleanDomain name="bool"/>')
+    @_doc("Colour by the chosen point array through the colour map; off: the solid colour.")
     def SetColorByArray(self, v):
         self._set("_colored", int(v))
 
@@ -298,56 +327,68 @@ class RTSurfaceRender(VTKPythonAlgorithmBase):
         self._set("_map", int(v))
 
     @smproperty.doublevector(name="SolidColor", default_values=[0.8, 0.8, 0.8])
+    @_doc("Colour (linear RGB, 0–1) when not coloured by an array.")
     def SetSolidColor(self, r, g, b):
         self._set("_color", (float(r), float(g), float(b)))
 
     @smproperty.intvector(name="UseCustomRange", default_values=[0])
     @smdomain.xml('<BooleanDomain name="bool"/>')
+    @_doc("Map the array over Range instead of its range over all ranks.")
     def SetUseCustomRange(self, v):
         self._set("_custom_range", int(v))
 
     @smproperty.doublevector(name="Range", default_values=[0.0, 1.0])
+    @_doc("Array values at the colour map's two ends (in the array's units), with UseCustomRange.")
     def SetRange(self, lo, hi):
         self._set("_range", (float(lo), float(hi)))
 
     @smproperty.intvector(name="ImageSize", default_values=[512, 512])
+    @_doc("Image width and height in pixels.")
     def SetImageSize(self, w, h):
         self._set("_size", (int(w), int(h)))
 
     @smproperty.doublevector(name="ViewDirection",
                              default_values=[0.0, 0.0, 1.0])
+    @_doc("Direction from the data toward the camera (any length); the camera frames the data's bounds.")
     def SetViewDirection(self, x, y, z):
         self._set("_direction", (float(x), float(y), float(z)))
 
     @smproperty.doublevector(name="ViewUp", default_values=[0.0, 1.0, 0.0])
+    @_doc("Up direction of the image.")
     def SetViewUp(self, x, y, z):
         self._set("_up", (float(x), float(y), float(z)))
 
     @smproperty.doublevector(name="ViewAngle", default_values=[30.0])
+    @_doc("Vertical field of view in degrees.")
     def SetViewAngle(self, v):
         self._set("_angle", float(v))
 
     @smproperty.intvector(name="AOSamples", default_values=[0])
     @smdomain.intrange(min=0, max=64)
+    @_doc("Ambient-occlusion rays per pixel and pass (0: off).")
     def SetAOSamples(self, v):
         self._set("_ao", int(v))
 
     @smproperty.doublevector(name="AODistance",
                              default_values=[0.0])
+    @_doc("Longest ambient-occlusion ray in the data's units (0: a tenth of the bounds' diagonal).")
     def SetAODistance(self, v):
         self._set("_ao_distance", float(v))
 
     @smproperty.intvector(name="Shadows", default_values=[1])
     @smdomain.xml('<BooleanDomain name="bool"/>')
+    @_doc("Shadow rays toward the light.")
     def SetShadows(self, v):
         self._set("_shadows", int(v))
 
     @smproperty.intvector(name="Passes", default_values=[1])
     @smdomain.intrange(min=1, max=256)
+    @_doc("Progressive passes averaged (anti-aliasing, less AO noise).")
     def SetPasses(self, v):
         self._set("_passes", int(v))
 
     @smproperty.intvector(name="Seed", default_values=[0])
+    @_doc("Random seed of the pixel jitter and AO rays: the same seed gives the same image at any thread and rank count.")
     def SetSeed(self, v):
         self._set("_seed", int(v))
 
@@ -358,11 +399,13 @@ class RTSurfaceRender(VTKPythonAlgorithmBase):
 
     @smproperty.doublevector(name="SphereRadius",
                              default_values=[0.0])
+    @_doc("Radius of the spheres drawn for vertices, in the data's units (0: 0.5 % of the bounds' diagonal).")
     def SetSphereRadius(self, v):
         self._set("_sphere_radius", float(v))
 
     @smproperty.doublevector(name="TubeRadius",
                              default_values=[0.0])
+    @_doc("Radius of the tubes drawn for lines, in the data's units (0: 0.2 % of the bounds' diagonal).")
     def SetTubeRadius(self, v):
         self._set("_tube_radius", float(v))
 

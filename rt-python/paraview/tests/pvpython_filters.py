@@ -77,4 +77,31 @@ assert 0.1 < hit.mean() < 0.9, hit.mean()
 assert np.all(img["RGBA"][~hit] == 0.0) and np.all(img["RGBA"][hit, 3] > 0.99)
 rtvis.save_png(os.path.join(out_dir, "paraview-surface.png"), img["RGB"].astype(np.uint8))
 print(f"RT Surface Render: 320×240, {hit.mean():.0%} of pixels hit; wrote paraview-surface.png")
+# Every property says what it is, with its unit, as a tooltip; the menu
+# labels are the README's.
+from paraview import servermanager  # noqa: E402
+
+for proxy, label in [(knife, "RT Schlieren"), (surface, "RT Surface Render")]:
+    assert proxy.SMProxy.GetXMLLabel() == label, proxy.SMProxy.GetXMLLabel()
+    it = proxy.SMProxy.NewPropertyIterator()
+    it.Begin()
+    undocumented = []
+    while not it.IsAtEnd():
+        prop = it.GetProperty()
+        doc = prop.GetDocumentation()
+        if it.GetKey() != "Input" and not prop.GetInformationOnly() and (
+                doc is None or not (doc.GetDescription() or "").strip()):
+            undocumented.append(it.GetKey())
+        it.Next()
+    assert not undocumented, f"{label}: no tooltip on {undocumented}"
+# Non-physical samples: refused by default, accepted on request.
+neg = Calculator(Input=src, ResultArrayName="density", Function="-1.0 + 0.0*coordsX")
+try:
+    refused = "Intensity" not in arrays(RTSchlieren(Input=neg, Array=["POINTS", "density"], Size=32, Photons=1))
+except Exception:  # noqa: BLE001 (ParaView reports the filter's error; the output is empty)
+    refused = True
+assert refused, "a negative density was accepted without AllowNonphysical"
+img = arrays(RTSchlieren(Input=neg, Array=["POINTS", "density"], Size=32, Photons=1, AllowNonphysical=1))
+assert img["Intensity"].shape == (32, 32), img.keys()
+print("labels and tooltips: every property documented; AllowNonphysical=1 accepts what the default refuses")
 print("pvpython: both filters ok")
