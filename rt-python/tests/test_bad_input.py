@@ -48,6 +48,36 @@ def test_bad_volume_options():
     rtvis.Volume(ok * 0.5, quantity="index", allow_nonphysical=True)
 
 
+def test_xyz_ordered_arrays_are_the_same_volume():
+    # A density bump off centre along +x only: indexed [x, y, z] (yt,
+    # Fortran) with order="xyz", it is the same volume as the [z, y, x]
+    # array, and its knife-edge image is bright on the side the bump's
+    # gradient says, not mirrored across the diagonal.
+    x = np.linspace(-1, 1, 24)
+    zz, yy, xx = np.meshgrid(x, x, x, indexing="ij")
+    zyx = 1.2 + 0.3 * np.exp(-((xx - 0.3) ** 2 + yy**2 + zz**2) / 0.05)
+    xyz = np.ascontiguousarray(zyx.transpose(2, 1, 0))
+    a = rtvis.Volume(zyx, spacing=(1e-2,) * 3)
+    b = rtvis.Volume(xyz, spacing=(1e-2,) * 3, order="xyz")
+    assert b.shape == a.shape == (24, 24, 24)
+    assert np.array_equal(a.index(), b.index())
+    ia = rtvis.schlieren(a, cutoff="knife", size=48)
+    ib = rtvis.schlieren(b, cutoff="knife", size=48)
+    assert np.array_equal(ia, ib)
+    # Read as [z, y, x] by mistake, the bump moves to +z: off the image's
+    # centre no more along x.
+    c = rtvis.Volume(xyz, spacing=(1e-2,) * 3)
+    assert not np.array_equal(rtvis.schlieren(c, cutoff="knife", size=48), ia)
+    with pytest.raises(ValueError, match="order: unknown 'yxz'"):
+        rtvis.Volume(zyx, order="yxz")
+    # Nested lists too, and a bad sample is named by the caller's indices.
+    assert np.array_equal(rtvis.Volume(xyz.tolist(), spacing=(1e-2,) * 3, order="xyz").index(), a.index())
+    bad = xyz.copy()
+    bad[5, 1, 0] = np.nan
+    with pytest.raises(ValueError, match=r"\(5, 1, 0\) is not finite"):
+        rtvis.Volume(bad, order="xyz")
+
+
 def test_strided_and_fortran_arrays_are_read_in_logical_order():
     base = np.random.default_rng(0).uniform(1.0, 2.0, size=(10, 12, 14))
     strided = base[::2, ::3, ::2]  # not contiguous

@@ -17,6 +17,7 @@ GLADSTONE_DALE_AIR: float = _rtvis.GLADSTONE_DALE_AIR
 
 _QUANTITIES = ("density", "index")
 _INTERPOLATIONS = ("linear", "cubic")
+_ORDERS = ("zyx", "xyz")
 
 
 class Volume:
@@ -25,10 +26,10 @@ class Volume:
 
     Parameters
     ----------
-    values : ndarray, shape (nz, ny, nx), float32 or float64
-        Samples, ``values[k, j, i]`` at ``origin + (i·dx, j·dy, k·dz)``
-        (x varies fastest, as VTK and NRRD store it). Any strides; copied.
-        Stored as float32.
+    values : ndarray, shape (nz, ny, nx) (or (nx, ny, nz), see ``order``)
+        Samples, float32 or float64: ``values[k, j, i]`` at ``origin +
+        (i·dx, j·dy, k·dz)`` (x varies fastest, as VTK and NRRD store
+        it). Any strides; copied. Stored as float32.
     spacing : 3 numbers, default (1, 1, 1)
         Sample spacing ``(dx, dy, dz)``, > 0, in metres (or your unit).
     origin : 3 numbers, default (0, 0, 0)
@@ -44,6 +45,11 @@ class Volume:
         so shadowgraphs show the grid).
     allow_nonphysical : bool
         Accept densities ≤ 0 or indices below 1.
+    order : "zyx" or "xyz"
+        How ``values`` is indexed: ``"zyx"`` (the default), ``values[k, j,
+        i]`` as above; ``"xyz"``, ``values[i, j, k]``, as yt's arrays and
+        Fortran codes index them. Nothing else changes: ``shape`` and
+        :meth:`index` stay ``[z, y, x]``.
 
     The index outside the volume is that of sample ``[0, 0, 0]``.
     """
@@ -57,8 +63,14 @@ class Volume:
         k: float = GLADSTONE_DALE_AIR,
         interpolation: str = "cubic",
         allow_nonphysical: bool = False,
+        order: str = "zyx",
     ):
+        xyz = _choice("order", order, _ORDERS) == "xyz"
+        # Checked in the caller's order (a bad sample is named by its own
+        # indices), then laid out x fastest.
         arr = _array("values", values, 3, np.float32)
+        if xyz:
+            arr = np.ascontiguousarray(arr.transpose(2, 1, 0))
         self._v = _rtvis._Volume(
             arr,
             _vector("spacing", spacing),
