@@ -17,6 +17,20 @@ def gaussian():
     return bump()
 
 
+def test_aliasing_fringes_warn_as_a_runtime_warning_of_rtvis(gaussian):
+    vol, _, _ = gaussian
+    assert issubclass(rtvis.RtvisWarning, RuntimeWarning)
+    # Green light through the bump on 16 pixels: many radians a pixel.
+    with pytest.warns(rtvis.RtvisWarning, match="fringes alias"):
+        rtvis.interferogram(vol, wavelength=532e-9, size=16)
+    # A millimetre wave does not alias: no warning at all.
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rtvis.interferogram(vol, wavelength=1e-3, size=16)
+
+
 def test_deflection_matches_the_analytic_bump(gaussian):
     vol, sigma, delta = gaussian
     _, eps = rtvis.schlieren(vol, f=1.0, h=4e-4, size=96, deflection=True)

@@ -40,7 +40,7 @@ import numpy as np  # noqa: F401
 # ones too (the tests call ``rtvis._bench`` and ``rtvis._rtvis``), so that
 # every name ``rtvis`` had before the split is still one of its attributes.
 from . import _rtvis
-from ._checks import _array, _choice, _integer, _number, _vector
+from ._checks import RtvisWarning, _array, _choice, _integer, _number, _vector
 from ._volume import (
     _INTERPOLATIONS,
     _MESH_KINDS,
@@ -83,6 +83,7 @@ __all__ = [
     "bos",
     "Camera",
     "Mesh",
+    "RtvisWarning",
     "Scene",
     "Volume",
     "color_schlieren",

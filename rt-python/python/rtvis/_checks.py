@@ -10,6 +10,12 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 
 
+class RtvisWarning(RuntimeWarning):
+    """A render that ran, but may not show what you expect: fringes that
+    alias, … (``warnings.filterwarnings("error", category=RtvisWarning)``
+    makes them errors; Jupyter shows them under the cell)."""
+
+
 def _choice(name: str, value, known: Sequence[str]) -> str:
     if not isinstance(value, str):
         raise TypeError(f"{name}: expected one of {', '.join(known)} (a str), got {type(value).__name__}")

@@ -9,7 +9,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from . import _rtvis
-from ._checks import _array, _float, _integer, _number, _str, _uint
+from ._checks import RtvisWarning, _array, _float, _integer, _number, _str, _uint
 from ._volume import Mesh, Volume
 
 
@@ -38,7 +38,7 @@ def _bench(volume, cutoff, *, angle=0.0, f=1.0, h=None, radius=None, half_range=
     if warning is not None:
         import warnings
 
-        warnings.warn(warning, stacklevel=3)
+        warnings.warn(warning, RtvisWarning, stacklevel=3)
     return tuple(out)
 
 
