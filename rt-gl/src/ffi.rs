@@ -64,12 +64,16 @@ fn param_count(pname: u32) -> usize {
         | gl::EMISSION
         | gl::AMBIENT_AND_DIFFUSE
         | gl::LIGHT_MODEL_AMBIENT
-        | gl::FOG_COLOR => 4,
+        | gl::FOG_COLOR
+        | gl::TEXTURE_ENV_COLOR
+        | gl::OBJECT_PLANE
+        | gl::EYE_PLANE => 4,
         _ => 1,
     }
 }
 
-/// Reads a light/material parameter vector of `pname`'s size.
+/// Reads a parameter vector of `pname`'s size (lights, materials, fog,
+/// texture environment and coordinate generation).
 ///
 /// # Safety
 /// A non-null `p` must point at that many values.
@@ -96,7 +100,8 @@ fn int_param(pname: u32, v: Vec4) -> Vec4 {
         | gl::EMISSION
         | gl::AMBIENT_AND_DIFFUSE
         | gl::LIGHT_MODEL_AMBIENT
-        | gl::FOG_COLOR => v / 2_147_483_647.0,
+        | gl::FOG_COLOR
+        | gl::TEXTURE_ENV_COLOR => v / 2_147_483_647.0,
         _ => v,
     }
 }
@@ -160,40 +165,6 @@ fn rect(x1: f32, y1: f32, x2: f32, y2: f32) {
     ] {
         rec(c);
     }
-}
-
-/// `glTexEnv*v` parameters: four for the colour, one otherwise.
-///
-/// # Safety
-/// `p` is null or points to as many values as `pname` takes.
-unsafe fn tex_env_params<T: Copy + Into<f64>>(pname: u32, p: *const T) -> Option<Vec4> {
-    if p.is_null() {
-        return None;
-    }
-    let n = if pname == gl::TEXTURE_ENV_COLOR { 4 } else { 1 };
-    let mut v = [0.0f32; 4];
-    for (i, x) in v.iter_mut().enumerate().take(n) {
-        // SAFETY: the caller guarantees `n` readable values.
-        *x = unsafe { (*p.add(i)).into() } as f32;
-    }
-    Some(Vec4::from_array(v))
-}
-
-/// `glTexGen*v` parameters: a plane's four, or the mode.
-///
-/// # Safety
-/// `p` is null or points to as many values as `pname` takes.
-unsafe fn tex_gen_params<T: Copy + Into<f64>>(pname: u32, p: *const T) -> Option<Vec4> {
-    if p.is_null() {
-        return None;
-    }
-    let n = if matches!(pname, gl::OBJECT_PLANE | gl::EYE_PLANE) { 4 } else { 1 };
-    let mut v = [0.0f32; 4];
-    for (i, x) in v.iter_mut().enumerate().take(n) {
-        // SAFETY: the caller guarantees `n` readable values.
-        *x = unsafe { (*p.add(i)).into() } as f32;
-    }
-    Some(Vec4::from_array(v))
 }
 
 /// The client image a `glTex(Sub)Image2D` call points at, if it can be
@@ -378,15 +349,15 @@ intercept! {
     glTexParameterfv(target: u32, pname: u32, v: *const f32) { if let Some([x]) = unsafe { read(v) } { with_recorder(|r| r.tex_parameter(target, pname, x)); } }
     glTexEnvi(target: u32, pname: u32, v: i32) { if target == 0x2300 { rec(Command::TexEnv(pname, Vec4::new(v as f32, 0.0, 0.0, 0.0))) } }
     glTexEnvf(target: u32, pname: u32, v: f32) { if target == 0x2300 { rec(Command::TexEnv(pname, Vec4::new(v, 0.0, 0.0, 0.0))) } }
-    glTexEnvfv(target: u32, pname: u32, v: *const f32) { if target == 0x2300 && let Some(p) = unsafe { tex_env_params(pname, v) } { rec(Command::TexEnv(pname, p)) } }
-    glTexEnviv(target: u32, pname: u32, v: *const i32) { if target == 0x2300 && let Some(p) = unsafe { tex_env_params(pname, v) } { rec(Command::TexEnv(pname, if pname == gl::TEXTURE_ENV_COLOR { p / 2_147_483_647.0 } else { p })) } }
+    glTexEnvfv(target: u32, pname: u32, v: *const f32) { if target == 0x2300 && let Some(p) = unsafe { params(pname, v) } { rec(Command::TexEnv(pname, p)) } }
+    glTexEnviv(target: u32, pname: u32, v: *const i32) { if target == 0x2300 && let Some(p) = unsafe { params(pname, v) } { rec(Command::TexEnv(pname, int_param(pname, p))) } }
     glPixelStorei(pname: u32, v: i32) { with_recorder(|r| r.pixel_store(pname, v)); }
     glAlphaFunc(func: u32, reference: f32) { rec(Command::AlphaFunc(func, reference)) }
     glDepthFunc(func: u32) { rec(Command::DepthFunc(func)) }
     glTexGeni(coord: u32, pname: u32, v: i32) { rec(Command::TexGen(coord, pname, Vec4::new(v as f32, 0.0, 0.0, 0.0))) }
     glTexGenf(coord: u32, pname: u32, v: f32) { rec(Command::TexGen(coord, pname, Vec4::new(v, 0.0, 0.0, 0.0))) }
-    glTexGenfv(coord: u32, pname: u32, v: *const f32) { if let Some(p) = unsafe { tex_gen_params(pname, v) } { rec(Command::TexGen(coord, pname, p)) } }
-    glTexGendv(coord: u32, pname: u32, v: *const f64) { if let Some(p) = unsafe { tex_gen_params(pname, v) } { rec(Command::TexGen(coord, pname, p)) } }
+    glTexGenfv(coord: u32, pname: u32, v: *const f32) { if let Some(p) = unsafe { params(pname, v) } { rec(Command::TexGen(coord, pname, p)) } }
+    glTexGendv(coord: u32, pname: u32, v: *const f64) { if let Some(p) = unsafe { params(pname, v) } { rec(Command::TexGen(coord, pname, p)) } }
     glBitmap(w: i32, h: i32, xo: f32, yo: f32, xm: f32, ym: f32, b: *const u8) { let _ = b; rec(Command::Bitmap { size: [w, h], origin: glam::Vec2::new(xo, yo), advance: glam::Vec2::new(xm, ym) }) }
     glDrawPixels(w: i32, h: i32, format: u32, ty: u32, data: *const c_void) { let _ = (format, ty, data); rec(Command::DrawPixels([w, h])) }
     glRasterPos2i(x: i32, y: i32) { rec(Command::RasterPos(Vec4::new(x as f32, y as f32, 0.0, 1.0))) }
