@@ -3,7 +3,8 @@
 //! exact or a smooth mesh; traced with the medium's own settings
 //! ([`Medium::params`]), not the instrument's.
 
-use rt_volume::{Medium, TraceParams};
+use glam::DVec3;
+use rt_volume::{Medium, TraceError, TraceParams, TraceResult};
 
 use crate::{
     BenchError, Bos, BosError, BosImages, Film, FocusingError, FocusingImages, FocusingSchlieren,
@@ -27,12 +28,29 @@ impl SchlierenBench {
         pass: u64,
         seed: u64,
     ) -> Result<(), BenchError> {
+        self.render_medium_until(medium, film, pass, seed, &|| false)
+    }
+
+    /// [`SchlierenBench::render_medium`] that asks `stop` before each
+    /// photon and, once it says yes, fails with
+    /// [`TraceError::Stopped`] (an interrupt within a photon's time).
+    ///
+    /// # Errors
+    /// As [`SchlierenBench::render`].
+    pub fn render_medium_until(
+        &self,
+        medium: &Medium,
+        film: &mut Film,
+        pass: u64,
+        seed: u64,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<(), BenchError> {
         let params: TraceParams = medium.params();
         match medium {
             Medium::Grid(g) => {
-                self.render_grid_with(g.field(), g.tree(), &params, film, pass, seed)
+                self.render_grid_with(g.field(), g.tree(), &params, film, pass, seed, stop)
             }
-            _ => self.render_with(&|o, d| medium.trace(o, d, None), film, pass, seed),
+            _ => self.render_with(&until(stop, |o, d| medium.trace(o, d, None)), film, pass, seed),
         }
     }
 
@@ -56,16 +74,27 @@ impl Bos {
     /// # Errors
     /// As [`Bos::render`].
     pub fn render_medium(&self, medium: &Medium, seed: u64) -> Result<BosImages, BosError> {
-        match medium {
-            Medium::Grid(_) => {
-                let b = medium.bounds();
-                let axis = self.camera.direction.normalize();
-                let z_a = (0.5 * (b.min + b.max) - self.camera.position).dot(axis);
-                let tol = self.resolvable_deflection(z_a);
-                self.render_with(&|o, d| medium.trace(o, d, Some(tol)), seed)
-            }
-            _ => self.render_with(&|o, d| medium.trace(o, d, None), seed),
-        }
+        self.render_medium_until(medium, seed, &|| false)
+    }
+
+    /// [`Bos::render_medium`] that asks `stop` before each ray and, once it
+    /// says yes, fails with [`TraceError::Stopped`].
+    ///
+    /// # Errors
+    /// As [`Bos::render`].
+    pub fn render_medium_until(
+        &self,
+        medium: &Medium,
+        seed: u64,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<BosImages, BosError> {
+        let tol = matches!(medium, Medium::Grid(_)).then(|| {
+            let b = medium.bounds();
+            let axis = self.camera.direction.normalize();
+            let z_a = (0.5 * (b.min + b.max) - self.camera.position).dot(axis);
+            self.resolvable_deflection(z_a)
+        });
+        self.render_with(&until(stop, |o, d| medium.trace(o, d, tol)), seed)
     }
 }
 
@@ -81,7 +110,29 @@ impl FocusingSchlieren {
         medium: &Medium,
         seed: u64,
     ) -> Result<FocusingImages, FocusingError> {
-        let skip = matches!(medium, Medium::Grid(_)).then(|| self.resolvable_deflection());
-        self.render_with(&|o, d| medium.trace(o, d, skip), seed)
+        self.render_medium_until(medium, seed, &|| false)
     }
+
+    /// [`FocusingSchlieren::render_medium`] that asks `stop` before each
+    /// ray and, once it says yes, fails with [`TraceError::Stopped`].
+    ///
+    /// # Errors
+    /// As [`FocusingSchlieren::render`].
+    pub fn render_medium_until(
+        &self,
+        medium: &Medium,
+        seed: u64,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<FocusingImages, FocusingError> {
+        let skip = matches!(medium, Medium::Grid(_)).then(|| self.resolvable_deflection());
+        self.render_with(&until(stop, |o, d| medium.trace(o, d, skip)), seed)
+    }
+}
+
+/// `trace`, unless `stop` says to stop: then [`TraceError::Stopped`].
+pub(crate) fn until<'a>(
+    stop: &'a (dyn Fn() -> bool + Sync),
+    trace: impl Fn(DVec3, DVec3) -> Result<TraceResult, TraceError> + Sync + 'a,
+) -> impl Fn(DVec3, DVec3) -> Result<TraceResult, TraceError> + Sync + 'a {
+    move |o, d| if stop() { Err(TraceError::Stopped) } else { trace(o, d) }
 }

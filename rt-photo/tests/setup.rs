@@ -154,3 +154,36 @@ fn bad_options_are_refused_by_name() {
     let e = FocusingSetup::choose(&m, &pitch).unwrap_err().to_string();
     assert_eq!(e, "pitch must be finite and > 0 (got inf)");
 }
+
+/// `render_until` stops when told, on every instrument, with
+/// `SetupError::Stopped` (not a trace error), after tracing part of the
+/// image only; and a `stop` that never says yes changes nothing: the same
+/// film, bit for bit, as `render`.
+#[test]
+fn renders_stop_when_told_and_only_then() {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    let m = medium(Interp::CatmullRom);
+    // Says yes from its `after`-th question on, counting the questions.
+    let stop_after = |after: u64| {
+        let asked = AtomicU64::new(0);
+        move || asked.fetch_add(1, Ordering::Relaxed) >= after
+    };
+    let o = SchlierenOptions { size: 48, photons: 4, ..SchlierenOptions::default() };
+    let setup = SchlierenSetup::choose(&m, &o).unwrap();
+    let mut passes = 0;
+    let got = setup.render_until(&m, 1, &mut |_, _| passes += 1, &stop_after(1000));
+    assert!(matches!(got, Err(SetupError::Stopped)), "{got:?}");
+    assert_eq!(passes, 0, "stopped inside the first pass");
+    let never = setup.render_until(&m, 1, &mut |_, _| {}, &|| false).unwrap();
+    assert_eq!(never, setup.render(&m, 1, &mut |_, _| {}).unwrap());
+
+    let bos = BosSetup::choose(&m, &BosOptions { size: 48, ..BosOptions::default() }).unwrap();
+    let got = bos.render_until(&m, 1, &stop_after(100));
+    assert!(matches!(got, Err(SetupError::Stopped)), "BOS: {:?}", got.map(|_| ()));
+    let foc =
+        FocusingSetup::choose(&m, &FocusingOptions { size: 48, ..FocusingOptions::default() })
+            .unwrap();
+    let got = foc.render_until(&m, 1, &stop_after(100));
+    assert!(matches!(got, Err(SetupError::Stopped)), "focusing: {:?}", got.map(|_| ()));
+    assert!(foc.render_until(&m, 1, &|| false).is_ok());
+}

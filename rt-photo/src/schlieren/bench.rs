@@ -420,6 +420,7 @@ impl SchlierenBench {
         film: &mut Film,
         pass: u64,
         seed: u64,
+        stop: &(dyn Fn() -> bool + Sync),
     ) -> Result<(), BenchError> {
         self.validate()?;
         let window = BeamWindow {
@@ -431,7 +432,8 @@ impl SchlierenBench {
         };
         let mask = BeamMask::build(field, tree, &window, self.skip_tolerance(field, film))
             .map_err(BenchError::Trace)?;
-        self.render_with(&|o, d| trace_beam(field, tree, &mask, o, d, params), film, pass, seed)
+        let trace = crate::medium::until(stop, |o, d| trace_beam(field, tree, &mask, o, d, params));
+        self.render_with(&trace, film, pass, seed)
     }
 
     /// [`SchlierenBench::render`] with any tracer `(origin, direction) → result`,

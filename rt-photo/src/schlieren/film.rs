@@ -96,6 +96,11 @@ pub enum FilmError {
     /// A [`Filter::WideTent`] radius that is NaN, infinite or below one
     /// pixel.
     BadFilterRadius(f64),
+    /// The accumulators did not fit in memory (the allocator refused).
+    OutOfMemory {
+        /// Bytes asked for.
+        bytes: usize,
+    },
 }
 
 impl fmt::Display for FilmError {
@@ -111,6 +116,9 @@ impl fmt::Display for FilmError {
             ),
             Self::BadFilterRadius(r) => {
                 write!(f, "wide tent filter radius {r} must be finite and at least 1 pixel")
+            }
+            Self::OutOfMemory { bytes } => {
+                write!(f, "a film of {bytes} bytes does not fit in memory")
             }
         }
     }
@@ -162,16 +170,15 @@ impl Film {
         {
             return Err(FilmError::BadFilterRadius(radius));
         }
-        Ok(Self {
-            width,
-            height,
-            filter,
-            rgb: alloc::vec![[0.0; 3]; n],
-            eps: alloc::vec![[0.0; 4]; n],
-            emitted: 0,
-            lost: 0,
-            per_pixel: 0.0,
-        })
+        // Fallible: a film too large for the machine is an `Err`, not an
+        // abort of the program that embeds it.
+        let bytes = n * (size_of::<[f64; 3]>() + size_of::<[f64; 4]>());
+        let (mut rgb, mut eps) = (Vec::new(), Vec::new());
+        rgb.try_reserve_exact(n).map_err(|_| FilmError::OutOfMemory { bytes })?;
+        eps.try_reserve_exact(n).map_err(|_| FilmError::OutOfMemory { bytes })?;
+        rgb.resize(n, [0.0; 3]);
+        eps.resize(n, [0.0; 4]);
+        Ok(Self { width, height, filter, rgb, eps, emitted: 0, lost: 0, per_pixel: 0.0 })
     }
 
     /// Width in pixels.

@@ -138,7 +138,24 @@ impl BosSetup {
     /// # Errors
     /// A failing trace.
     pub fn render(&self, medium: &Medium, seed: u64) -> Result<BosImages, SetupError> {
-        Ok(self.bos.render_medium(medium, seed)?)
+        self.render_until(medium, seed, &|| false)
+    }
+
+    /// [`BosSetup::render`] that asks `stop` before each ray (from the
+    /// worker threads): once it says yes, the render ends within a ray's
+    /// time with [`SetupError::Stopped`].
+    ///
+    /// # Errors
+    /// A failing trace or [`SetupError::Stopped`].
+    pub fn render_until(
+        &self,
+        medium: &Medium,
+        seed: u64,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<BosImages, SetupError> {
+        self.bos
+            .render_medium_until(medium, seed, stop)
+            .map_err(|e| SetupError::stopped_or(stop, e))
     }
 }
 

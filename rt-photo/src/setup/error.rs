@@ -40,6 +40,8 @@ pub enum SetupError {
     Bos(BosError),
     /// The focusing rig or render failed.
     Focusing(FocusingError),
+    /// The caller's `stop` asked the render to end (`render_until`).
+    Stopped,
 }
 
 impl fmt::Display for SetupError {
@@ -59,6 +61,7 @@ impl fmt::Display for SetupError {
             Self::SchlierenBench(e) => e.fmt(f),
             Self::Bos(e) => e.fmt(f),
             Self::Focusing(e) => e.fmt(f),
+            Self::Stopped => write!(f, "the render was stopped"),
         }
     }
 }
@@ -72,6 +75,14 @@ impl core::error::Error for SetupError {
             Self::Focusing(e) => Some(e),
             _ => None,
         }
+    }
+}
+
+impl SetupError {
+    /// [`SetupError::Stopped`] once `stop` says so (the trace failed
+    /// because it was told to), else `e`.
+    pub(crate) fn stopped_or(stop: &dyn Fn() -> bool, e: impl Into<Self>) -> Self {
+        if stop() { Self::Stopped } else { e.into() }
     }
 }
 

@@ -134,7 +134,24 @@ impl FocusingSetup {
     /// # Errors
     /// A failing trace.
     pub fn render(&self, medium: &Medium, seed: u64) -> Result<FocusingImages, SetupError> {
-        Ok(self.system.render_medium(medium, seed)?)
+        self.render_until(medium, seed, &|| false)
+    }
+
+    /// [`FocusingSetup::render`] that asks `stop` before each ray (from the
+    /// worker threads): once it says yes, the render ends within a ray's
+    /// time with [`SetupError::Stopped`].
+    ///
+    /// # Errors
+    /// A failing trace or [`SetupError::Stopped`].
+    pub fn render_until(
+        &self,
+        medium: &Medium,
+        seed: u64,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<FocusingImages, SetupError> {
+        self.system
+            .render_medium_until(medium, seed, stop)
+            .map_err(|e| SetupError::stopped_or(stop, e))
     }
 }
 

@@ -197,13 +197,32 @@ impl SchlierenSetup {
         seed: u64,
         progress: &mut dyn FnMut(u64, u64),
     ) -> Result<Film, SetupError> {
+        self.render_until(medium, seed, progress, &|| false)
+    }
+
+    /// [`SchlierenSetup::render`] that asks `stop` before each photon (from
+    /// the worker threads): once it says yes, the render ends within a
+    /// photon's time with [`SetupError::Stopped`].
+    ///
+    /// # Errors
+    /// A failing trace, [`SetupError::Stopped`], or a film that does not
+    /// fit in memory.
+    pub fn render_until(
+        &self,
+        medium: &Medium,
+        seed: u64,
+        progress: &mut dyn FnMut(u64, u64),
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Film, SetupError> {
         let (w, h) = self.size;
         let mut film = Film::new(w, h, Filter::Tent)?;
         let (strata, passes) = lattice(self.options.photons);
         let bench = SchlierenBench { strata, ..self.bench.clone() };
         let per_pass = (w * h) as u64 * u64::from(strata * strata);
         for pass in 0..passes {
-            bench.render_medium(medium, &mut film, pass, seed)?;
+            bench
+                .render_medium_until(medium, &mut film, pass, seed, stop)
+                .map_err(|e| SetupError::stopped_or(stop, e))?;
             progress(per_pass * (pass + 1), per_pass * passes);
         }
         Ok(film)

@@ -180,6 +180,9 @@ pub enum TraceError {
     },
     /// Words that no [`PathState`](super::PathState) writes ([`PathState::from_words`](super::PathState::from_words)).
     InvalidState,
+    /// The caller asked the trace to stop (a render interrupted between
+    /// rays; nothing wrong with the ray).
+    Stopped,
 }
 
 impl fmt::Display for TraceError {
@@ -189,6 +192,7 @@ impl fmt::Display for TraceError {
             Self::InvalidParams => write!(f, "trace parameters must be finite and positive"),
             Self::BadField { at } => write!(f, "field is not finite and positive at {at}"),
             Self::InvalidState => write!(f, "not the words of a ray's path state"),
+            Self::Stopped => write!(f, "stopped on request"),
         }
     }
 }
