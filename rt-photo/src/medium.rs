@@ -4,7 +4,7 @@
 //! ([`Medium::params`]), not the instrument's.
 
 use glam::DVec3;
-use rt_volume::{Medium, TraceError, TraceParams, TraceResult};
+use rt_volume::{Medium, TraceError, TraceResult};
 
 use crate::{
     BenchError, Bos, BosError, BosImages, Film, FocusingError, FocusingImages, FocusingSchlieren,
@@ -45,11 +45,8 @@ impl SchlierenBench {
         seed: u64,
         stop: &(dyn Fn() -> bool + Sync),
     ) -> Result<(), BenchError> {
-        let params: TraceParams = medium.params();
         match medium {
-            Medium::Grid(g) => {
-                self.render_grid_with(g.field(), g.tree(), &params, film, pass, seed, stop)
-            }
+            Medium::Grid(g) => self.render_grid_with(g, &medium.params(), film, pass, seed, stop),
             _ => self.render_with(&until(stop, |o, d| medium.trace(o, d, None)), film, pass, seed),
         }
     }

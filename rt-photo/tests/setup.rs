@@ -161,7 +161,7 @@ fn bad_options_are_refused_by_name() {
 /// film, bit for bit, as `render`.
 #[test]
 fn renders_stop_when_told_and_only_then() {
-    use std::sync::atomic::{AtomicU64, Ordering};
+    use core::sync::atomic::{AtomicU64, Ordering};
     let m = medium(Interp::CatmullRom);
     // Says yes from its `after`-th question on, counting the questions.
     let stop_after = |after: u64| {

@@ -7,8 +7,8 @@ use glam::DVec3;
 use rt_core::ColorMap;
 use rt_core::sampling::{rng_for, uniform};
 use rt_volume::{
-    BeamMask, BeamWindow, GridField, IndexField, Octree, TraceError, TraceParams, TraceResult,
-    trace, trace_beam, trace_visiting,
+    BeamMask, BeamWindow, GridField, IndexField, TraceError, TraceParams, TraceResult, trace,
+    trace_beam, trace_visiting,
 };
 
 use super::cutoff::Prepared;
@@ -405,17 +405,16 @@ impl SchlierenBench {
     }
 
     /// [`SchlierenBench::render`] for a gridded field on the fast path
-    /// ([`SchlierenBench::render_medium`] of a grid): the octree `tree` lets photons
+    /// ([`SchlierenBench::render_medium`] of a grid): the grid's octree lets photons
     /// cross the field's smooth regions in straight steps, with the
     /// tolerance the bench cannot resolve ([`SchlierenBench::skip_tolerance`]);
     /// photons whose line meets no node too rough for it (a [`BeamMask`]
     /// with one cell per film pixel) go straight without walking the tree.
-    /// `tree` bounds `field`'s own interpolant (a [`rt_volume::GridMedium`]
-    /// builds them together).
+    /// The grid's octree bounds its own interpolant (a
+    /// [`rt_volume::GridMedium`] builds them together).
     pub(crate) fn render_grid_with(
         &self,
-        field: &GridField,
-        tree: &Octree,
+        grid: &rt_volume::GridMedium,
         params: &TraceParams,
         film: &mut Film,
         pass: u64,
@@ -423,6 +422,7 @@ impl SchlierenBench {
         stop: &(dyn Fn() -> bool + Sync),
     ) -> Result<(), BenchError> {
         self.validate()?;
+        let (field, tree) = (grid.field(), grid.tree());
         let window = BeamWindow {
             center: self.center,
             direction: self.direction,
