@@ -13,6 +13,7 @@ mod composite;
 mod optics;
 mod surface;
 mod volume;
+mod watch;
 
 use pyo3::{exceptions::PyValueError, prelude::*};
 

@@ -8,15 +8,16 @@
 
 use numpy::{
     IntoPyArray, PyArray2, PyArray3, PyReadonlyArray2,
-    ndarray::{Array2, Array3},
+    ndarray::{Array2, Array3, ArrayD},
 };
-use pyo3::prelude::*;
+use pyo3::{exceptions::PyMemoryError, prelude::*, types::PyDict};
 use rt_photo::{
-    Airy, Axis, BackgroundChoice, BosOptions, BosRigOptions, BosSetup, CutoffKind, FocusingOptions,
-    FocusingRigOptions, FocusingSetup, Reconstruction, SchlierenOptions, SchlierenSetup, Sensor,
+    Airy, Axis, BackgroundChoice, BosOptions, BosRigOptions, BosSetup, Cutoff, CutoffKind,
+    FocusingOptions, FocusingRigOptions, FocusingSetup, Mode, Reconstruction, SchlierenOptions,
+    SchlierenSetup, Sensor,
 };
 
-use crate::{value_error, volume::PyVolume};
+use crate::{value_error, volume::PyVolume, watch::watched};
 
 /// The axis named `s`.
 fn axis(s: &str) -> PyResult<Axis> {
@@ -55,25 +56,82 @@ fn estimator(s: &str) -> PyResult<Reconstruction> {
     }
 }
 
-/// The film as `(image [h, w, 3] relative to an undisturbed beam with
-/// nothing cut, in the f64 the film accumulates in, mean deflection [h, w, 2] in radians (NaN where no photon
-/// landed), the mean interferometric phase [h, w] in radians (NaN where
-/// no photon landed; 0 outside interferometry), the image of an
-/// undisturbed beam through the optics (RGB), a line saying which optics
-/// were chosen, a warning about the set-up (aliasing fringes) or None)`.
+/// `(image [h, w] or [h, w, 3] (RGB when `rgb`) relative to the
+/// undisturbed background (where that is not black), of the dtype asked
+/// for; the mean deflection [h, w, 2] in radians, NaN where no photon
+/// landed (when asked for); the mean interferometric phase [h, w] in
+/// radians, NaN where no photon landed, 0 outside interferometry (when
+/// asked for); the optics chosen, by the keyword names of
+/// `rtvis.schlieren`; a line saying which; a warning about the set-up
+/// (aliasing fringes) or None)`.
 type Optics<'py> = (
-    Bound<'py, PyArray3<f64>>,
-    Bound<'py, PyArray3<f32>>,
-    Bound<'py, PyArray2<f64>>,
-    [f32; 3],
+    Bound<'py, PyAny>,
+    Option<Bound<'py, PyArray3<f32>>>,
+    Option<Bound<'py, PyArray2<f64>>>,
+    Bound<'py, PyDict>,
     String,
     Option<String>,
 );
 
-/// Renders `volume` on the bench the arguments describe.
+/// A vector of `n` items from `items`, or `MemoryError` if it does not
+/// fit: outputs are as large as the film, and a machine that just held
+/// the film may not hold them too.
+pub(crate) fn filled<T>(n: usize, items: impl Iterator<Item = T>) -> PyResult<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| {
+        PyMemoryError::new_err(format!(
+            "rtvis: an output of {} bytes does not fit in memory",
+            n.saturating_mul(core::mem::size_of::<T>())
+        ))
+    })?;
+    v.extend(items.take(n));
+    Ok(v)
+}
+
+/// A set-up error as Python sees it: a film too large for memory is a
+/// `MemoryError`, anything else a `ValueError`.
+pub(crate) fn setup_error(e: rt_photo::SetupError) -> PyErr {
+    match e {
+        rt_photo::SetupError::Film(rt_photo::FilmError::OutOfMemory { bytes }) => {
+            PyMemoryError::new_err(format!(
+                "rtvis: the film's {bytes} bytes do not fit in memory (a smaller size fits)"
+            ))
+        }
+        e => value_error(e),
+    }
+}
+
+/// The optics `setup` chose, keyed by `rtvis.schlieren`'s keywords.
+fn chosen<'py>(py: Python<'py>, setup: &SchlierenSetup) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let o = &setup.options;
+    match &setup.bench.mode {
+        Mode::Schlieren(c) => match c {
+            Cutoff::KnifeEdge { h, .. } => d.set_item("h", h)?,
+            Cutoff::Graded { width, .. } => d.set_item("h", width)?,
+            Cutoff::Pinhole { radius, .. } => d.set_item("radius", radius)?,
+            Cutoff::Color(filter) => d.set_item("half_range", filter.half_range)?,
+            _ => {}
+        },
+        Mode::Interferometry { lambda, fringe_spacing, .. } => {
+            d.set_item("wavelength", lambda)?;
+            d.set_item("fringe_spacing", fringe_spacing)?;
+        }
+    }
+    d.set_item("angle", o.angle)?;
+    d.set_item("f", o.f)?;
+    d.set_item("film_distance", setup.bench.film_distance)?;
+    d.set_item("size", o.size)?;
+    d.set_item("photons", o.photons)?;
+    Ok(d)
+}
+
+/// Renders `volume` on the bench the arguments describe; `output` is
+/// `(rgb, float64, relative, deflection, phase)`: what to return
+/// (`relative`: divided by the background's level).
 #[pyfunction]
 #[pyo3(name = "_optics")]
-#[pyo3(signature = (volume, cutoff_name, angle, f, h, radius, half_range, wavelength, fringe_spacing, film_distance, axis_name, size, photons, seed, estimator_name))]
+#[pyo3(signature = (volume, cutoff_name, angle, f, h, radius, half_range, wavelength, fringe_spacing, film_distance, axis_name, size, photons, seed, estimator_name, output, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn optics<'py>(
     py: Python<'py>,
@@ -92,6 +150,8 @@ pub(crate) fn optics<'py>(
     photons: u32,
     seed: u64,
     estimator_name: &str,
+    output: (bool, bool, bool, bool, bool),
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Optics<'py>> {
     let options = SchlierenOptions {
         cutoff: cutoff(cutoff_name)?,
@@ -108,33 +168,54 @@ pub(crate) fn optics<'py>(
         photons,
         reconstruction: estimator(estimator_name)?,
     };
+    let (rgb, wide, relative, want_deflection, want_phase) = output;
     let v = &volume.inner;
-    let (film, setup) = py
-        .detach(|| -> Result<_, rt_photo::SetupError> {
-            let setup = SchlierenSetup::choose(v, &options)?;
-            let film = setup.render(v, seed, &mut |_, _| {})?;
-            Ok((film, setup))
-        })
-        .map_err(value_error)?;
+    let (film, setup) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
+        let setup = SchlierenSetup::choose(v, &options)?;
+        let film = setup.render_until(v, seed, &mut |d, t| w.progress(d, t), &|| w.stopped())?;
+        Ok((film, setup))
+    })?
+    .map_err(setup_error)?;
     let (w, h) = (film.width(), film.height());
-    let rgb: Vec<f64> = film.normalized_f64().into_iter().flatten().collect();
-    let eps: Vec<f32> = film
-        .mean_deflection()
-        .into_iter()
-        .flat_map(|e| e.map_or([f32::NAN; 2], |(u, v)| [u as f32, v as f32]))
-        .collect();
-    let phase: Vec<f64> = film.mean_phase().into_iter().map(|p| p.unwrap_or(f64::NAN)).collect();
-    let image = Array3::from_shape_vec((h, w, 3), rgb).map_err(value_error)?;
-    let deflection = Array3::from_shape_vec((h, w, 2), eps).map_err(value_error)?;
-    let phase = Array2::from_shape_vec((h, w), phase).map_err(value_error)?;
-    Ok((
-        image.into_pyarray(py),
-        deflection.into_pyarray(py),
-        phase.into_pyarray(py),
-        setup.background(),
-        setup.to_string(),
-        setup.warning,
-    ))
+    let n = w * h;
+    // Relative to the background, channel by channel, where it is not
+    // black (a dark field's is).
+    let b = setup.background().map(f64::from);
+    let scale = |p: [f64; 3], c: usize| if relative && b[c] > 0.0 { p[c] / b[c] } else { p[c] };
+    let channels = if rgb { 3 } else { 1 };
+    let pixels =
+        || film.normalized_iter().flat_map(move |p| (0..channels).map(move |c| scale(p, c)));
+    let shape = [h, w, channels];
+    let image: Bound<'py, PyAny> = if wide {
+        let a = ArrayD::from_shape_vec(
+            &shape[..if rgb { 3 } else { 2 }],
+            filled(n * channels, pixels())?,
+        );
+        a.map_err(value_error)?.into_pyarray(py).into_any()
+    } else {
+        let a = ArrayD::from_shape_vec(
+            &shape[..if rgb { 3 } else { 2 }],
+            filled(n * channels, pixels().map(|x| x as f32))?,
+        );
+        a.map_err(value_error)?.into_pyarray(py).into_any()
+    };
+    let deflection = if want_deflection {
+        let eps = film
+            .deflection_iter()
+            .flat_map(|e| e.map_or([f32::NAN; 2], |(u, v)| [u as f32, v as f32]));
+        let a = Array3::from_shape_vec((h, w, 2), filled(2 * n, eps)?).map_err(value_error)?;
+        Some(a.into_pyarray(py))
+    } else {
+        None
+    };
+    let phase = if want_phase {
+        let phi = film.phase_iter().map(|p| p.unwrap_or(f64::NAN));
+        Some(Array2::from_shape_vec((h, w), filled(n, phi)?).map_err(value_error)?.into_pyarray(py))
+    } else {
+        None
+    };
+    drop(film);
+    Ok((image, deflection, phase, chosen(py, &setup)?, setup.to_string(), setup.warning))
 }
 
 /// Records an intensity image (1 = background) as a camera sensor would
@@ -175,7 +256,7 @@ type BosOut<'py> =
 /// sensor pixels as imaged (default: it spans the width).
 #[pyfunction]
 #[pyo3(name = "_bos")]
-#[pyo3(signature = (volume, axis_name, size, focal_length, f_number, pixel, distance, background_distance, dot, spacing, samples, seed, background, image=None, image_pixel=None))]
+#[pyo3(signature = (volume, axis_name, size, focal_length, f_number, pixel, distance, background_distance, dot, spacing, samples, seed, background, image=None, image_pixel=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn bos<'py>(
     py: Python<'py>,
@@ -194,6 +275,7 @@ pub(crate) fn bos<'py>(
     background: &str,
     image: Option<PyReadonlyArray2<'py, f64>>,
     image_pixel: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<BosOut<'py>> {
     let background = match (image, background) {
         (Some(i), _) => {
@@ -229,13 +311,12 @@ pub(crate) fn bos<'py>(
         seed,
     };
     let v = &volume.inner;
-    let (setup, images) = py
-        .detach(|| -> Result<_, rt_photo::SetupError> {
-            let setup = BosSetup::choose(v, &options)?;
-            let images = setup.render(v, seed)?;
-            Ok((setup, images))
-        })
-        .map_err(value_error)?;
+    let (setup, images) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
+        let setup = BosSetup::choose(v, &options)?;
+        let images = setup.render_until(v, seed, &|| w.stopped())?;
+        Ok((setup, images))
+    })?
+    .map_err(setup_error)?;
     let (bos, rig) = (&setup.bos, &setup.rig);
     let (w, h) = (images.width, images.height);
     let c = bos.camera;
@@ -261,7 +342,7 @@ type FocusingOut<'py> =
 /// Focusing schlieren of `volume` ([`FocusingSetup`]).
 #[pyfunction]
 #[pyo3(name = "_focusing")]
-#[pyo3(signature = (volume, axis_name, size, focal_length, aperture, pixel, distance, focus, source_distance, pitch, duty, angle, offset, bands, samples, seed))]
+#[pyo3(signature = (volume, axis_name, size, focal_length, aperture, pixel, distance, focus, source_distance, pitch, duty, angle, offset, bands, samples, seed, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn focusing<'py>(
     py: Python<'py>,
@@ -281,6 +362,7 @@ pub(crate) fn focusing<'py>(
     bands: Option<u32>,
     samples: u32,
     seed: u64,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<FocusingOut<'py>> {
     let options = FocusingOptions {
         axis: axis(axis_name)?,
@@ -301,13 +383,12 @@ pub(crate) fn focusing<'py>(
         samples_per_axis: samples,
     };
     let v = &volume.inner;
-    let (setup, images) = py
-        .detach(|| -> Result<_, rt_photo::SetupError> {
-            let setup = FocusingSetup::choose(v, &options)?;
-            let images = setup.render(v, seed)?;
-            Ok((setup, images))
-        })
-        .map_err(value_error)?;
+    let (setup, images) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
+        let setup = FocusingSetup::choose(v, &options)?;
+        let images = setup.render_until(v, seed, &|| w.stopped())?;
+        Ok((setup, images))
+    })?
+    .map_err(setup_error)?;
     let fs = &setup.system;
     let (w, h) = (images.width, images.height);
     let c = fs.camera;

@@ -6,14 +6,17 @@ use numpy::{
     IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2,
     ndarray::{Array2, Array3},
 };
-use pyo3::prelude::*;
-use rt_core::{Camera, ColorMap, Projection, intersect::Sphere};
+use pyo3::{
+    exceptions::{PyMemoryError, PyRuntimeError},
+    prelude::*,
+};
+use rt_core::{Camera, ColorMap, FrameError, Projection, intersect::Sphere};
 use rt_surface::{
-    Light, Material, Mesh, Renderer, Settings,
+    Light, Material, Mesh, RenderError, Renderer, Settings,
     scene::{Glyphs, Paint, SurfaceScene, Tube},
 };
 
-use crate::value_error;
+use crate::{optics::filled, value_error, watch::watched};
 
 /// How an object is coloured, as given.
 #[derive(Clone, Debug)]
@@ -277,7 +280,7 @@ impl PyScene {
         (lo.cmple(hi).all()).then(|| (lo.to_array(), hi.to_array()))
     }
 
-    #[pyo3(signature = (eye, target, up, fov, ortho_height, width, height, lights, shadows, ao, ao_distance, passes, seed))]
+    #[pyo3(signature = (eye, target, up, fov, ortho_height, width, height, lights, shadows, ao, ao_distance, passes, seed, progress=None))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -295,6 +298,7 @@ impl PyScene {
         ao_distance: f32,
         passes: u32,
         seed: u64,
+        progress: Option<Py<PyAny>>,
     ) -> PyResult<Image<'py>> {
         if !(1..=16384).contains(&width) || !(1..=16384).contains(&height) {
             return Err(value_error(format!(
@@ -352,23 +356,58 @@ impl PyScene {
                 }),
             };
         }
-        let frame = py
-            .detach(|| -> Result<_, String> {
-                let scene = b.build().map_err(|e| format!("scene: {e}"))?;
-                let mut r =
-                    Renderer::new(camera, settings).map_err(|e| format!("renderer: {e}"))?;
-                for _ in 0..passes {
-                    r.render_pass(&scene);
+        // Stopped between passes (a pass is one sample per pixel); the
+        // progress counts tiles over all passes.
+        let frame = watched(py, progress, |w| -> Result<_, RenderFailure> {
+            let scene = b.build().map_err(|e| RenderFailure::Other(format!("scene: {e}")))?;
+            let mut r = Renderer::new(camera, settings).map_err(RenderFailure::render)?;
+            for pass in 0..u64::from(passes) {
+                if w.stopped() {
+                    return Err(RenderFailure::Stopped);
                 }
-                r.frame().map_err(|e| format!("frame: {e}"))
-            })
-            .map_err(value_error)?;
+                r.render_pass_with_progress(&scene, |done, tiles| {
+                    let tiles = tiles as u64;
+                    w.progress(pass * tiles + done as u64, u64::from(passes) * tiles);
+                });
+            }
+            r.frame().map_err(|e| RenderFailure::render(RenderError::Frame(e)))
+        })?
+        .map_err(RenderFailure::into_py)?;
         let (w, h) = (frame.width() as usize, frame.height() as usize);
-        let rgba: Vec<f32> = frame.pixels().iter().flat_map(|p| p.color).collect();
-        let depth: Vec<f32> = frame.pixels().iter().map(|p| p.depth).collect();
+        let rgba = filled(4 * w * h, frame.pixels().iter().flat_map(|p| p.color))?;
+        let depth = filled(w * h, frame.pixels().iter().map(|p| p.depth))?;
         Ok((
             Array3::from_shape_vec((h, w, 4), rgba).map_err(value_error)?.into_pyarray(py),
             Array2::from_shape_vec((h, w), depth).map_err(value_error)?.into_pyarray(py),
         ))
+    }
+}
+
+/// Why a surface render failed.
+enum RenderFailure {
+    /// The frame did not fit in memory.
+    OutOfMemory,
+    /// Told to stop (the watcher raises the reason itself).
+    Stopped,
+    /// Anything else, said.
+    Other(String),
+}
+
+impl RenderFailure {
+    fn render(e: RenderError) -> Self {
+        match e {
+            RenderError::Frame(FrameError::OutOfMemory) => Self::OutOfMemory,
+            e => Self::Other(format!("renderer: {e}")),
+        }
+    }
+
+    fn into_py(self) -> PyErr {
+        match self {
+            Self::OutOfMemory => PyMemoryError::new_err(
+                "rtvis: the image's accumulators do not fit in memory (a smaller size fits)",
+            ),
+            Self::Stopped => PyRuntimeError::new_err("rtvis: the render was stopped"),
+            Self::Other(e) => value_error(e),
+        }
     }
 }

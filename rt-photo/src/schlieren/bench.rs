@@ -191,6 +191,10 @@ pub struct SchlierenBench {
     pub params: TraceParams,
 }
 
+/// Photons a sheet pass holds at once (56 bytes each: 117 MB); a larger
+/// lattice is traced and shared out in bands of rows.
+const SHEET_BAND_PHOTONS: usize = 1 << 21;
+
 /// Rows `0..n` of photons traced by `row` (in parallel with feature
 /// `parallel`), in order; the first error if any row fails.
 fn rows(
@@ -504,6 +508,18 @@ impl SchlierenBench {
         pass: u64,
         seed: u64,
     ) -> Result<(), BenchError> {
+        self.sheet_in_bands(tracer, film, pass, seed, SHEET_BAND_PHOTONS)
+    }
+
+    /// [`SchlierenBench::sheet`] holding about `band_photons` photons at once.
+    fn sheet_in_bands(
+        &self,
+        tracer: &(impl Fn(DVec3, DVec3) -> Result<(TraceResult, [f32; 3]), TraceError> + Sync),
+        film: &mut Film,
+        pass: u64,
+        seed: u64,
+        band_photons: usize,
+    ) -> Result<(), BenchError> {
         let (w, h) = (film.width(), film.height());
         let k = self.strata as usize;
         let kf = k as f64;
@@ -523,24 +539,39 @@ impl SchlierenBench {
                 })
                 .collect()
         };
-        let lattice = rows(ny, trace_row)?;
-        film.emitted += (nx * ny) as u64;
-        // Lost: photons emitted inside the beam that landed off the film
-        // (the lattice's outer ring starts outside it).
-        film.lost += lattice
-            .iter()
-            .enumerate()
-            .flat_map(|(b, row)| row.iter().enumerate().map(move |(a, p)| (a, b, p)))
-            .filter(|&(a, b, p)| {
-                let (x, y) = (at(a, sx), at(b, sy));
-                let emitted = x >= 0.0 && y >= 0.0 && x < w as f64 && y < h as f64;
-                emitted && !(p.x >= 0.0 && p.y >= 0.0 && p.x < w as f64 && p.y < h as f64)
-            })
-            .count() as u64;
         // Light per unit emission area: a full cell (1/k² pixel²) carries
         // one photon's worth, so the background is k² per pixel per pass.
         let density = kf * kf;
-        film.deposit_sheet(&lattice, |a, b| (at(a, sx), at(b, sy)), density);
+        // The lattice in bands of rows, each band's cells shared out before
+        // the next is traced (with the row they share): memory stays at a
+        // band's photons, not a film's worth; cells reach each pixel in
+        // the same order, so the image is the same, bit for bit.
+        let band = (band_photons / nx).max(2);
+        let mut carried: Option<Vec<Photon>> = None;
+        let mut b0 = 0;
+        while b0 < ny {
+            let b1 = (b0 + band).min(ny);
+            let traced = rows(b1 - b0, |i| trace_row(b0 + i))?;
+            film.emitted += ((b1 - b0) * nx) as u64;
+            // Lost: photons emitted inside the beam that landed off the
+            // film (the lattice's outer ring starts outside it).
+            film.lost += traced
+                .iter()
+                .zip(b0..)
+                .flat_map(|(row, b)| row.iter().enumerate().map(move |(a, p)| (a, b, p)))
+                .filter(|&(a, b, p)| {
+                    let (x, y) = (at(a, sx), at(b, sy));
+                    let emitted = x >= 0.0 && y >= 0.0 && x < w as f64 && y < h as f64;
+                    emitted && !(p.x >= 0.0 && p.y >= 0.0 && p.x < w as f64 && p.y < h as f64)
+                })
+                .count() as u64;
+            // Row `first` of the lattice is local row 0.
+            let first = if carried.is_some() { b0 - 1 } else { b0 };
+            let mut lattice: Vec<Vec<Photon>> = carried.take().into_iter().chain(traced).collect();
+            film.deposit_sheet(&lattice, |a, b| (at(a, sx), at(first + b, sy)), density);
+            carried = lattice.pop();
+            b0 = b1;
+        }
         film.per_pixel += density;
         Ok(())
     }
@@ -560,4 +591,51 @@ pub(crate) fn mean_colour(
     })?;
     let c = if n > 0 { map.map((sum / f64::from(n)) as f32) } else { [1.0; 4] };
     Ok((r, [c[0], c[1], c[2]]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Filter, Weighting};
+    use rt_volume::GaussianBump;
+
+    /// The sheet traced and shared out in bands of a few rows is the
+    /// sheet of one band, bit for bit (cells reach each pixel in the same
+    /// order), photon counts included; a knife edge and a shadowgraph
+    /// (cells folded over each other) alike.
+    #[test]
+    fn a_sheet_in_bands_is_the_whole_sheet() {
+        let f = GaussianBump::new(DVec3::ZERO, 2e-3, 1.0, 5.0);
+        let knife = Cutoff::KnifeEdge { angle: 0.3, offset: 0.0, f: 1.0, h: 1e-3 };
+        for (mode, film_distance) in
+            [(Mode::Schlieren(knife), 0.0), (Mode::Schlieren(Cutoff::None), 900.0)]
+        {
+            let bench = SchlierenBench {
+                center: DVec3::new(0.0, 0.0, -6.0),
+                direction: DVec3::Z,
+                u: DVec3::X,
+                width: 6.0,
+                height: 4.0,
+                image_plane: 6.0,
+                film_distance,
+                mode,
+                weighting: Weighting::Weight,
+                reconstruction: Reconstruction::Sheet,
+                strata: 2,
+                params: TraceParams::accurate(),
+            };
+            let tracer = |o, d| trace(&f, o, d, &bench.params).map(|r| (r, [1.0; 3]));
+            let render = |band| {
+                let mut film = Film::new(30, 20, Filter::Tent).unwrap();
+                for pass in 0..2 {
+                    bench.sheet_in_bands(&tracer, &mut film, pass, 9, band).unwrap();
+                }
+                film
+            };
+            let whole = render(usize::MAX);
+            for band in [62 * 2, 62 * 5, 62 * 7 + 3] {
+                assert_eq!(render(band), whole, "bands of {} rows", band / 62);
+            }
+        }
+    }
 }

@@ -392,7 +392,9 @@ impl Film {
         self.normalized_iter().collect()
     }
 
-    fn normalized_iter(&self) -> impl Iterator<Item = [f64; 3]> + '_ {
+    /// [`Film::normalized_f64`] pixel by pixel, without the vector (an
+    /// image as large as the film need not be held twice).
+    pub fn normalized_iter(&self) -> impl Iterator<Item = [f64; 3]> + '_ {
         let k = if self.per_pixel > 0.0 { 1.0 / self.per_pixel } else { 0.0 };
         self.rgb.iter().map(move |p| [p[0] * k, p[1] * k, p[2] * k])
     }
@@ -401,7 +403,12 @@ impl Film {
     /// (the picking pass: where to paint a filter); `None` for empty pixels.
     #[must_use]
     pub fn mean_deflection(&self) -> Vec<Option<(f64, f64)>> {
-        self.eps.iter().map(|e| (e[2] > 0.0).then(|| (e[0] / e[2], e[1] / e[2]))).collect()
+        self.deflection_iter().collect()
+    }
+
+    /// [`Film::mean_deflection`] pixel by pixel.
+    pub fn deflection_iter(&self) -> impl Iterator<Item = Option<(f64, f64)>> + '_ {
+        self.eps.iter().map(|e| (e[2] > 0.0).then(|| (e[0] / e[2], e[1] / e[2])))
     }
 
     /// Mean interferometric phase (radians, unwrapped: see
@@ -409,7 +416,12 @@ impl Film {
     /// for empty pixels; 0 where the bench is not an interferometer.
     #[must_use]
     pub fn mean_phase(&self) -> Vec<Option<f64>> {
-        self.eps.iter().map(|e| (e[2] > 0.0).then(|| e[3] / e[2])).collect()
+        self.phase_iter().collect()
+    }
+
+    /// [`Film::mean_phase`] pixel by pixel.
+    pub fn phase_iter(&self) -> impl Iterator<Item = Option<f64>> + '_ {
+        self.eps.iter().map(|e| (e[2] > 0.0).then(|| e[3] / e[2]))
     }
 }
 

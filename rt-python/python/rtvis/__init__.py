@@ -77,12 +77,15 @@ from ._surface import (
 )
 from ._composite import _ABANDONED_SENDS, _image_pair, _Mpi4pyComm, composite, composite_mpi
 from ._image import _srgb8, save_png, to_gray8, to_srgb8
+from ._watch import Optics, ProgressCallback
 
 __all__ = [
     "GLADSTONE_DALE_AIR",
     "bos",
     "Camera",
     "Mesh",
+    "Optics",
+    "ProgressCallback",
     "RtvisWarning",
     "Scene",
     "Volume",

@@ -47,6 +47,9 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
     f-number ``N·(1 + M)`` that :func:`record`'s ``airy`` wants).
     Paraxially ``|Δ| = M·Z_D·|ε|/pitch``, ``M = f/(Z_A + Z_D − f)``.
 
+    Ctrl-C stops the render within a fraction of a second
+    (``KeyboardInterrupt``).
+
     Example: ``ref, flow, disp, info = rtvis.bos(vol, background="grid")``.
     """
     if not isinstance(volume, (Volume, Mesh)):

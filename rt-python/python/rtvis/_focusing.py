@@ -75,6 +75,9 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
     (offset·pitch)`` for a deflection ``ε`` across the bands in the focus
     plane at ``Z_F``, the source grid at ``Z_S``.
 
+    Ctrl-C stops the render within a fraction of a second
+    (``KeyboardInterrupt``).
+
     Example: ``ref, flow, rel, info = rtvis.focusing(vol, focus=0.01,
     aperture=0.3)``.
     """

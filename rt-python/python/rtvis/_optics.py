@@ -4,18 +4,30 @@ the focal plane), and ``record`` (a camera sensor's counts)."""
 
 from __future__ import annotations
 
-from typing import Optional, Tuple
+from typing import Any, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _rtvis
 from ._checks import RtvisWarning, _array, _float, _integer, _number, _str, _uint
 from ._volume import Mesh, Volume
+from ._watch import Optics, ProgressCallback, _progress
 
 
-def _bench(volume, cutoff, *, angle=0.0, f=1.0, h=None, radius=None, half_range=None,
-           wavelength=10.6e-6, fringe_spacing=None, film_distance=None, axis="z", size=512,
-           photons=16, seed=1, estimator="sheet"):
+# The function a progress bar names, by the bench's cutoff.
+_NAMES = {"none": "rtvis.shadowgraph", "interferometry": "rtvis.interferogram", "color": "rtvis.color_schlieren"}
+
+
+def _bench(volume: Union[Volume, Mesh], cutoff: str, *, angle: float = 0.0, f: float = 1.0,
+           h: Optional[float] = None, radius: Optional[float] = None, half_range: Optional[float] = None,
+           wavelength: float = 10.6e-6, fringe_spacing: Optional[float] = None,
+           film_distance: Optional[float] = None, axis: str = "z", size: int = 512, photons: int = 16,
+           seed: int = 1, estimator: str = "sheet",
+           output: Tuple[bool, bool, bool, bool, bool] = (True, True, False, True, True),
+           progress: Union[None, bool, ProgressCallback] = None) -> Tuple[Any, ...]:
+    """The bench's film: ``(image, deflection, phase, chosen, description)``;
+    ``output = (rgb, float64, relative, deflection, phase)`` says what to
+    make (the default: the film's own RGB in float64, everything)."""
     if not isinstance(volume, (Volume, Mesh)):
         raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
     *out, warning = _rtvis._optics(
@@ -34,22 +46,24 @@ def _bench(volume, cutoff, *, angle=0.0, f=1.0, h=None, radius=None, half_range=
         _uint("photons", photons),
         _uint("seed", seed, 64),
         _str("estimator", estimator),
+        tuple(bool(o) for o in output),
+        _progress(progress, _NAMES.get(cutoff, "rtvis.schlieren")),
     )
     if warning is not None:
         import warnings
 
-        warnings.warn(warning, RtvisWarning, stacklevel=3)
+        warnings.warn(warning, RtvisWarning, stacklevel=4)
     return tuple(out)
 
 
-def _dtype(dtype):
+def _dtype(dtype: Any) -> np.dtype:
     d = np.dtype(dtype)
     if d not in (np.dtype(np.float32), np.dtype(np.float64)):
         raise ValueError(f"dtype: expected float32 or float64, got {d}")
     return d
 
 
-def _grey(image: np.ndarray, background, dtype) -> np.ndarray:
+def _grey(image: np.ndarray, background: Sequence[float], dtype: Any) -> np.ndarray:
     """Channel 0 (in f64) divided by the background's level (when it is
     not 0), as `dtype`."""
     b = float(background[0])
@@ -57,8 +71,35 @@ def _grey(image: np.ndarray, background, dtype) -> np.ndarray:
     return np.ascontiguousarray(g / b if b > 0.0 else g, dtype=_dtype(dtype))
 
 
+def _render(volume: Union[Volume, Mesh], cutoff: str, keywords: Sequence[str], renamed: Mapping[str, str],
+            fixed: Mapping[str, Any], *, deflection: bool, phase: bool = False, dtype: Any,
+            chosen: bool, progress: Union[None, bool, ProgressCallback], **options: Any) -> Any:
+    """One of the public renders: the image, then the deflection, the
+    phase and the chosen optics as asked for. ``keywords`` are the
+    function's own optics keywords (the chosen values' names, as
+    ``renamed`` maps the bench's names to them), ``fixed`` those it was
+    called with that the bench did not choose."""
+    wide = _dtype(dtype) == np.dtype(np.float64)
+    image, eps, phi, picked, said = _bench(
+        volume, cutoff, output=(cutoff == "color", wide, True, deflection, phase), progress=progress, **options
+    )
+    out: Tuple[Any, ...] = (image,)
+    if deflection:
+        out += (eps,)
+    if phase:
+        out += (phi,)
+    if chosen:
+        fields = dict(fixed)
+        for name, value in picked.items():
+            name = renamed.get(name, name)
+            if name in keywords:
+                fields[name] = value
+        out += (Optics(said, **{k: fields[k] for k in keywords if k in fields}),)
+    return out if len(out) > 1 else out[0]
+
+
 def schlieren(
-    volume: Volume,
+    volume: Union[Volume, Mesh],
     cutoff: str = "knife",
     angle: float = 0.0,
     f: float = 1.0,
@@ -72,8 +113,10 @@ def schlieren(
     seed: int = 1,
     estimator: str = "sheet",
     deflection: bool = False,
-    dtype=np.float32,
-):
+    dtype: Any = np.float32,
+    chosen: bool = False,
+    progress: Union[None, bool, ProgressCallback] = None,
+) -> Any:
     """Synthetic schlieren of ``volume``: a parallel beam along ``axis``
     through the whole volume, photons bent along curved paths by the
     index gradient, then the cutoff in the focal plane of a lens of focal
@@ -120,6 +163,15 @@ def schlieren(
         The image's type; the film accumulates in float64, so float64
         keeps differences below float32's 6e-8 relative step (weak
         signals, two renders compared).
+    chosen : bool
+        Also return the optics used, automatic choices included, as an
+        :class:`Optics` (last in the tuple): ``schlieren(other, **chosen)``
+        repeats them exactly (a time series with one exposure).
+    progress : True or callable, optional
+        ``True``: a progress bar on stderr; a callable: called as
+        ``progress(done, total)`` (photons) on the calling thread.
+        Ctrl-C stops the render within a fraction of a second and raises
+        ``KeyboardInterrupt``.
 
     Returns
     -------
@@ -135,43 +187,43 @@ def schlieren(
         horizontal and vertical axes; NaN where none landed.
 
     The same options and seed give the same image as ``rt schlieren``.
+    A film too large for memory raises ``MemoryError``.
     """
-    image, eps, _, background, _ = _bench(
-        volume, _str("cutoff", cutoff), angle=angle, f=f, h=h, radius=radius,
-        half_range=half_range, film_distance=film_distance, axis=axis, size=size,
-        photons=photons, seed=seed, estimator=estimator,
-    )
-    if cutoff == "color":
-        out = image / np.asarray(background, dtype=np.float64)
-        out = np.ascontiguousarray(out, dtype=_dtype(dtype))
-    else:
-        out = _grey(image, background, dtype)
-    return (out, eps) if deflection else out
+    cutoff = _str("cutoff", cutoff)
+    keywords = ("cutoff", "angle", "f", "h", "radius", "half_range", "film_distance", "axis", "size",
+                "photons", "seed", "estimator")
+    fixed = dict(cutoff=cutoff, axis=axis, seed=seed, estimator=estimator)
+    return _render(volume, cutoff, keywords, {}, fixed, deflection=deflection, dtype=dtype, chosen=chosen,
+                   progress=progress, angle=angle, f=f, h=h, radius=radius, half_range=half_range,
+                   film_distance=film_distance, axis=axis, size=size, photons=photons, seed=seed,
+                   estimator=estimator)
 
 
 def shadowgraph(
-    volume: Volume,
+    volume: Union[Volume, Mesh],
     distance: Optional[float] = None,
     axis: str = "z",
     size: int = 512,
     photons: int = 16,
     seed: int = 1,
     deflection: bool = False,
-    dtype=np.float32,
-):
+    dtype: Any = np.float32,
+    chosen: bool = False,
+    progress: Union[None, bool, ProgressCallback] = None,
+) -> Any:
     """Synthetic shadowgraph: no cutoff, the film ``distance`` metres
     behind the volume's mid-plane (default: automatic, the strongest
     contrast about 0.5). Returns the intensity relative to the undisturbed
-    beam, (h, w) of ``dtype`` (and the deflection, as :func:`schlieren`)."""
-    image, eps, _, background, _ = _bench(
-        volume, "none", film_distance=distance, axis=axis, size=size, photons=photons, seed=seed
-    )
-    out = _grey(image, background, dtype)
-    return (out, eps) if deflection else out
+    beam, (h, w) of ``dtype`` (and the deflection, and the chosen optics,
+    as :func:`schlieren`)."""
+    keywords = ("distance", "axis", "size", "photons", "seed")
+    return _render(volume, "none", keywords, {"film_distance": "distance"}, dict(axis=axis, seed=seed),
+                   deflection=deflection, dtype=dtype, chosen=chosen, progress=progress,
+                   film_distance=distance, axis=axis, size=size, photons=photons, seed=seed)
 
 
 def interferogram(
-    volume: Volume,
+    volume: Union[Volume, Mesh],
     wavelength: float = 10.6e-6,
     fringe_spacing: Optional[float] = None,
     axis: str = "z",
@@ -180,8 +232,10 @@ def interferogram(
     seed: int = 1,
     deflection: bool = False,
     phase: bool = False,
-    dtype=np.float32,
-):
+    dtype: Any = np.float32,
+    chosen: bool = False,
+    progress: Union[None, bool, ProgressCallback] = None,
+) -> Any:
     """Synthetic interferogram: ``I = (1 + cos(φ + 2π x/Λ))/2`` with the
     phase ``φ = (2π/λ)·∫(n − n_ref) ds`` along each curved path (``n_ref``:
     the first sample's index). ``wavelength`` λ in metres (default: CO₂
@@ -190,36 +244,35 @@ def interferogram(
     ``deflection=True`` also the deflection (as :func:`schlieren`); with
     ``phase=True`` also φ itself, float64 (h, w) in radians, **unwrapped**
     (each photon's own phase, averaged per pixel; no 2π ambiguity; NaN
-    where no photon landed), last in the tuple."""
-    image, eps, phi, background, _ = _bench(
-        volume, "interferometry", wavelength=wavelength, fringe_spacing=fringe_spacing,
-        axis=axis, size=size, photons=photons, seed=seed,
-    )
-    out = (_grey(image, background, dtype),)
-    if deflection:
-        out += (eps,)
-    if phase:
-        out += (phi,)
-    return out if len(out) > 1 else out[0]
+    where no photon landed); with ``chosen=True`` the optics, last."""
+    keywords = ("wavelength", "fringe_spacing", "axis", "size", "photons", "seed")
+    return _render(volume, "interferometry", keywords, {}, dict(axis=axis, seed=seed),
+                   deflection=deflection, phase=phase, dtype=dtype, chosen=chosen, progress=progress,
+                   wavelength=wavelength, fringe_spacing=fringe_spacing, axis=axis, size=size,
+                   photons=photons, seed=seed)
 
 
 def color_schlieren(
-    volume: Volume,
+    volume: Union[Volume, Mesh],
     half_range: Optional[float] = None,
     axis: str = "z",
     size: int = 512,
     photons: int = 16,
     seed: int = 1,
     deflection: bool = False,
-    dtype=np.float32,
-):
+    dtype: Any = np.float32,
+    chosen: bool = False,
+    progress: Union[None, bool, ProgressCallback] = None,
+) -> Any:
     """Colour (rainbow) schlieren: a hue-wheel filter in the focal plane,
     hue = direction of the deflection, saturation = its size relative to
     ``half_range`` (radians; default automatic). Returns linear RGB,
     float32 (h, w, 3), white where nothing deflects (and the deflection,
-    as :func:`schlieren`)."""
-    return schlieren(volume, "color", half_range=half_range, axis=axis, size=size,
-                     photons=photons, seed=seed, deflection=deflection, dtype=dtype)
+    and the chosen optics, as :func:`schlieren`)."""
+    keywords = ("half_range", "axis", "size", "photons", "seed")
+    return _render(volume, "color", keywords, {}, dict(axis=axis, seed=seed), deflection=deflection,
+                   dtype=dtype, chosen=chosen, progress=progress, half_range=half_range, axis=axis,
+                   size=size, photons=photons, seed=seed)
 
 
 def record(image, exposure: float = 10_000.0, full_well: float = 20_000.0, bits: int = 16,

@@ -4,12 +4,13 @@ glyphs, tubes) rendered into premultiplied RGBA and depth."""
 from __future__ import annotations
 
 import math
-from typing import Optional, Tuple, Union
+from typing import Any, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _rtvis
 from ._checks import _array, _choice, _integer, _number, _vector
+from ._watch import ProgressCallback, _progress
 
 
 class Camera:
@@ -165,7 +166,8 @@ class Scene:
 
     def render(self, camera: Optional[Camera] = None, size: Union[int, Tuple[int, int]] = 512,
                ao: int = 0, ao_distance: Optional[float] = None, shadows: bool = True,
-               passes: int = 1, seed: int = 0, lights=None):
+               passes: int = 1, seed: int = 0, lights: Optional[Sequence[Any]] = None,
+               progress: Union[None, bool, ProgressCallback] = None) -> Tuple[np.ndarray, np.ndarray]:
         """Ray traces the scene.
 
         Parameters
@@ -189,6 +191,11 @@ class Scene:
         lights : list, optional
             ``("ambient", rgb)``, ``("directional", toward_light, rgb)``,
             ``("point", position, rgb)``; default :data:`DEFAULT_LIGHTS`.
+        progress : True or callable, optional
+            ``True``: a progress bar on stderr; a callable: called as
+            ``progress(done, total)`` (tiles over all passes) on the
+            calling thread. Ctrl-C stops the render at the end of the pass
+            under way and raises ``KeyboardInterrupt``.
 
         Returns
         -------
@@ -197,6 +204,10 @@ class Scene:
         depth : ndarray, float32, (h, w)
             Distance along each camera ray to the first hit, ``inf`` where
             nothing was hit (ready for :func:`composite`).
+
+        :func:`to_srgb8` makes the colour display-ready (8-bit sRGB over a
+        background). Accumulators too large for memory raise
+        ``MemoryError``.
         """
         w, h = (size, size) if np.ndim(size) == 0 else tuple(size)
         w = _integer("size[0]", w, 1, 16384)
@@ -230,4 +241,5 @@ class Scene:
             native_lights, bool(shadows), _integer("ao", ao, 0, 4096),
             _number("ao_distance", ao_distance, positive=True),
             _integer("passes", passes, 1, 65536), _integer("seed", seed, 0, 2**64 - 1),
+            _progress(progress, "rtvis.Scene.render"),
         )
