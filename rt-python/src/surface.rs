@@ -356,8 +356,7 @@ impl PyScene {
                 }),
             };
         }
-        // Stopped between passes (a pass is one sample per pixel); the
-        // progress counts tiles over all passes.
+        // Stopped between tiles; the progress counts tiles over all passes.
         let frame = watched(py, progress, |w| -> Result<_, RenderFailure> {
             let scene = b.build().map_err(|e| RenderFailure::Other(format!("scene: {e}")))?;
             let mut r = Renderer::new(camera, settings).map_err(RenderFailure::render)?;
@@ -365,10 +364,13 @@ impl PyScene {
                 if w.stopped() {
                     return Err(RenderFailure::Stopped);
                 }
-                r.render_pass_with_progress(&scene, |done, tiles| {
+                let report = |done: usize, tiles: usize| {
                     let tiles = tiles as u64;
                     w.progress(pass * tiles + done as u64, u64::from(passes) * tiles);
-                });
+                };
+                if r.render_pass_until(&scene, report, &|| w.stopped()).is_none() {
+                    return Err(RenderFailure::Stopped);
+                }
             }
             r.frame().map_err(|e| RenderFailure::render(RenderError::Frame(e)))
         })?

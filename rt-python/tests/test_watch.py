@@ -131,7 +131,7 @@ def test_ctrl_c_interrupts_a_long_render(what):
     assert p.returncode == 0, err
     assert "interrupted" in out and "again (16, 16)" in out, out + err
     # Uninterrupted, each render runs for minutes; stopping takes a poll
-    # (50 ms) and a photon (or, for surfaces, the pass under way).
+    # (50 ms) and a photon, ray or tile.
     assert took < 20.0, f"{took:.1f} s after SIGINT"
 
 

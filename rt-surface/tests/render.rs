@@ -436,6 +436,18 @@ fn frames_are_identical_at_any_thread_count() {
     }
     assert!(same(&one, &r.frame().unwrap()));
 
+    // A pass told to stop after two tiles is dropped: the renderer keeps
+    // its three passes, and a pass after it is the fourth as if none had
+    // been stopped.
+    let asked = core::sync::atomic::AtomicUsize::new(0);
+    let stop = || asked.fetch_add(1, core::sync::atomic::Ordering::Relaxed) >= 2;
+    assert_eq!(pool.install(|| r.render_pass_until(&s, |_, _| {}, &stop)), None);
+    assert_eq!(r.passes(), 3);
+    assert!(same(&one, &r.frame().unwrap()));
+    let (four, _) = render(&s, view(), st.clone(), 4);
+    assert!(r.render_pass_until(&s, |_, _| {}, &|| false).is_some());
+    assert!(same(&four, &r.frame().unwrap()));
+
     // Camera rays go through the scene as one batch per tile, and shadow
     // and AO rays as one batch per tile and kind; asked one by one (the trait's
     // defaults), every pixel and count is the same.

@@ -176,6 +176,23 @@ impl Renderer {
         S: ShadeScene + Sync,
         P: Fn(usize, usize) + Sync,
     {
+        // A stop that never says yes never stops the pass.
+        self.render_pass_until(scene, progress, &|| false).unwrap_or_default()
+    }
+
+    /// [`Self::render_pass_with_progress`] that asks `stop` before each
+    /// tile: once it says yes the pass ends early and is dropped (`None`),
+    /// leaving the passes accumulated so far as they were.
+    pub fn render_pass_until<S, P>(
+        &mut self,
+        scene: &S,
+        progress: P,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Option<RayCounts>
+    where
+        S: ShadeScene + Sync,
+        P: Fn(usize, usize) + Sync,
+    {
         let (w, h) = (self.camera.width, self.camera.height);
         let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
             .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
@@ -185,17 +202,20 @@ impl Renderer {
         let pass = self.passes;
         let finished = AtomicUsize::new(0);
         let work = |&(x0, y0): &(u32, u32)| {
+            if stop() {
+                return None;
+            }
             let tile = ctx.tile(x0, y0, pass);
             progress(finished.fetch_add(1, Ordering::Relaxed) + 1, tiles.len());
-            tile
+            Some(tile)
         };
         #[cfg(feature = "parallel")]
         let done: Vec<TileResult> = {
             use rayon::prelude::*;
-            tiles.par_iter().map(work).collect()
+            tiles.par_iter().map(work).collect::<Option<_>>()?
         };
         #[cfg(not(feature = "parallel"))]
-        let done: Vec<TileResult> = tiles.iter().map(work).collect();
+        let done: Vec<TileResult> = tiles.iter().map(work).collect::<Option<_>>()?;
         let mut counts = RayCounts::default();
         for t in &done {
             counts.add(&t.counts);
@@ -212,7 +232,7 @@ impl Renderer {
         }
         self.passes += 1;
         self.counts.add(&counts);
-        counts
+        Some(counts)
     }
 
     /// The mean of the passes so far as a frame (background where no pass
