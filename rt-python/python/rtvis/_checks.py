@@ -5,7 +5,7 @@ shape, NaN, out of range or an unknown option."""
 from __future__ import annotations
 
 import math
-from typing import Optional, Sequence, Tuple
+from typing import Any, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -82,9 +82,10 @@ def _vector(name: str, value, n: int = 3) -> Tuple[float, ...]:
     return tuple(float(v) for v in a)
 
 
-def _array(name: str, value, ndim: int, dtype, *, last: Optional[int] = None, integer: bool = False) -> np.ndarray:
+def _array(name: str, value: Any, ndim: int, dtype: Any, *, last: Optional[int] = None, integer: bool = False,
+           nan: bool = False) -> np.ndarray:
     """``value`` as a C-contiguous array of ``dtype`` (copied if needed),
-    its kind and shape checked."""
+    its kind and shape checked; NaN allowed with ``nan``, infinities never."""
     if not isinstance(value, np.ndarray):
         try:
             value = np.asarray(value)
@@ -103,7 +104,7 @@ def _array(name: str, value, ndim: int, dtype, *, last: Optional[int] = None, in
         return np.ascontiguousarray(value, dtype=np.int64)
     with np.errstate(over="ignore", invalid="ignore"):  # reported below
         out = np.ascontiguousarray(value, dtype=dtype)
-    bad = ~np.isfinite(out)
+    bad = np.isinf(out) if nan else ~np.isfinite(out)
     if bad.any():
         where = tuple(int(i) for i in np.argwhere(bad)[0])
         raise ValueError(f"{name}: value at {where} is not finite ({out[where]})")

@@ -4,7 +4,7 @@
 
 from __future__ import annotations
 
-from typing import Optional, Tuple
+from typing import Any, Optional, Tuple
 
 import numpy as np
 
@@ -18,6 +18,27 @@ GLADSTONE_DALE_AIR: float = _rtvis.GLADSTONE_DALE_AIR
 _QUANTITIES = ("density", "index")
 _INTERPOLATIONS = ("linear", "cubic")
 _ORDERS = ("zyx", "xyz")
+_NANS = ("error", "ambient")
+# The image's (u, v) world axes for each beam axis: u to the right, v up.
+_IMAGE_AXES = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}
+
+
+def _extent(bounds: Tuple[Tuple[float, ...], Tuple[float, ...]], axis: str) -> Tuple[float, float, float, float]:
+    u, v = _IMAGE_AXES[_choice("axis", axis, tuple(_IMAGE_AXES))]
+    lo, hi = bounds
+    return (lo[u], hi[u], lo[v], hi[v])
+
+
+def _far_field(values: np.ndarray) -> float:
+    """The median of the finite samples on the volume's six faces: the
+    undisturbed medium around a flow."""
+    faces = [values[0], values[-1], values[:, 0], values[:, -1], values[:, :, 0], values[:, :, -1]]
+    edge = np.concatenate([f.ravel() for f in faces])
+    edge = edge[np.isfinite(edge)]
+    if edge.size == 0:
+        raise ValueError("values: no finite sample on the volume's faces to take as the ambient medium "
+                         "(nan=\"ambient\" needs one)")
+    return float(np.median(edge))
 
 
 class Volume:
@@ -50,6 +71,11 @@ class Volume:
         i]`` as above; ``"xyz"``, ``values[i, j, k]``, as yt's arrays and
         Fortran codes index them. Nothing else changes: ``shape`` and
         :meth:`index` stay ``[z, y, x]``.
+    nan : "error" or "ambient"
+        What a NaN sample is (blanked cells, a solid body, no data):
+        ``"error"`` (the default) refuses it; ``"ambient"`` makes it the
+        undisturbed medium, the median of the finite samples on the
+        volume's six faces. Infinities are always refused.
 
     The index outside the volume is that of sample ``[0, 0, 0]``.
     """
@@ -64,11 +90,17 @@ class Volume:
         interpolation: str = "cubic",
         allow_nonphysical: bool = False,
         order: str = "zyx",
-    ):
+        nan: str = "error",
+    ) -> None:
         xyz = _choice("order", order, _ORDERS) == "xyz"
+        ambient = _choice("nan", nan, _NANS) == "ambient"
         # Checked in the caller's order (a bad sample is named by its own
         # indices), then laid out x fastest.
-        arr = _array("values", values, 3, np.float32)
+        arr = _array("values", values, 3, np.float32, nan=ambient)
+        if ambient:
+            holes = np.isnan(arr)
+            if holes.any():
+                arr = np.where(holes, np.float32(_far_field(arr)), arr)
         if xyz:
             arr = np.ascontiguousarray(arr.transpose(2, 1, 0))
         self._v = _rtvis._Volume(
@@ -80,6 +112,63 @@ class Volume:
             _choice("interpolation", interpolation, _INTERPOLATIONS),
             bool(allow_nonphysical),
         )
+
+    @classmethod
+    def from_vtk(cls, image: Any, array: Optional[str] = None, **options: Any) -> "Volume":
+        """A volume from a VTK image (``vtkImageData``: what ParaView's
+        readers and ``vtkXMLImageDataReader`` give; a PyVista
+        ``ImageData`` is one too): its dimensions, spacing and origin, and
+        the point-data array ``array`` (default: the active scalars, else
+        the only array), or, failing that, a cell-data array sampled at
+        the cell centres. ``options`` as for :class:`Volume` (``quantity``,
+        ``nan``, …). An image with a rotated direction matrix is refused."""
+        for method in ("GetDimensions", "GetSpacing", "GetOrigin", "GetPointData", "GetCellData"):
+            if not callable(getattr(image, method, None)):
+                raise TypeError(f"image: expected a vtkImageData (or pyvista.ImageData), got {type(image).__name__}")
+        try:
+            from vtkmodules.util.numpy_support import vtk_to_numpy
+        except ImportError:  # VTK before 8.2
+            from vtk.util.numpy_support import vtk_to_numpy  # type: ignore[no-redef]
+        matrix = getattr(image, "GetDirectionMatrix", None)
+        if matrix is not None and not matrix().IsIdentity():
+            raise ValueError("image: its direction matrix is not the identity (a rotated image is not supported)")
+        dims = tuple(int(d) for d in image.GetDimensions())
+        spacing = tuple(float(h) for h in image.GetSpacing())
+        origin = tuple(float(o) for o in image.GetOrigin())
+        found = None
+        for where, data in (("point", image.GetPointData()), ("cell", image.GetCellData())):
+            names = [data.GetArrayName(i) for i in range(data.GetNumberOfArrays())]
+            if array is not None:
+                if array in names:
+                    found = (where, data.GetArray(array))
+            elif data.GetScalars() is not None:
+                found = (where, data.GetScalars())
+            elif len(names) == 1:
+                found = (where, data.GetArray(0))
+            if found is not None:
+                break
+        if found is None:
+            points = [image.GetPointData().GetArrayName(i) for i in range(image.GetPointData().GetNumberOfArrays())]
+            cells = [image.GetCellData().GetArrayName(i) for i in range(image.GetCellData().GetNumberOfArrays())]
+            want = f"no array {array!r}" if array is not None else "no active scalars and not exactly one array"
+            raise ValueError(f"image: {want} (point data: {points or 'none'}; cell data: {cells or 'none'})")
+        where, vtk_array = found
+        if vtk_array.GetNumberOfComponents() != 1:
+            raise ValueError(f"image: array {vtk_array.GetName()!r} has {vtk_array.GetNumberOfComponents()} components, "
+                             "not 1")
+        if where == "cell":
+            dims = tuple(max(d - 1, 1) for d in dims)
+            origin = tuple(o + 0.5 * h for o, h in zip(origin, spacing))
+        values = vtk_to_numpy(vtk_array).reshape(dims[::-1])
+        return cls(values, spacing=spacing, origin=origin, **options)
+
+    @classmethod
+    def from_pyvista(cls, grid: Any, array: Optional[str] = None, **options: Any) -> "Volume":
+        """A volume from a PyVista ``ImageData`` (``UniformGrid`` before
+        PyVista 0.43), as :meth:`from_vtk`."""
+        if type(grid).__module__.split(".")[0] != "pyvista":
+            raise TypeError(f"grid: expected a pyvista.ImageData, got {type(grid).__name__}")
+        return cls.from_vtk(grid, array, **options)
 
     @classmethod
     def _wrap(cls, native) -> "Volume":
@@ -112,6 +201,15 @@ class Volume:
     def index(self) -> np.ndarray:
         """The refractive index samples, float32 ``[z, y, x]``."""
         return self._v.index()
+
+    def extent(self, axis: str = "z") -> Tuple[float, float, float, float]:
+        """``(left, right, bottom, top)`` of the schlieren, shadowgraph,
+        interferogram and colour schlieren images along ``axis`` (they
+        span the volume's cross-section), in the volume's unit: for
+        ``matplotlib``'s ``imshow(image, extent=vol.extent(axis))`` (row 0
+        at the top, imshow's default). Image axes: x right and y up along
+        z; y and z along x; z and x along y."""
+        return _extent(self.bounds, axis)
 
     def __repr__(self) -> str:
         return f"rtvis.Volume(shape={self.shape}, spacing={self.spacing}, origin={self.origin})"
@@ -223,6 +321,11 @@ class Mesh:
     def counts(self) -> Tuple[int, int, int, int]:
         """``(points, cells, tetrahedra, boundary faces)``."""
         return tuple(self._v.mesh_counts)
+
+    def extent(self, axis: str = "z") -> Tuple[float, float, float, float]:
+        """``(left, right, bottom, top)`` of the images along ``axis``, as
+        :meth:`Volume.extent` (the images span the points' box)."""
+        return _extent(self.bounds, axis)
 
     def __repr__(self) -> str:
         p, c, t, _ = self.counts
