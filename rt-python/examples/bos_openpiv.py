@@ -25,8 +25,10 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+from numpy.typing import NDArray
 
 import rtvis
 
@@ -34,7 +36,8 @@ import rtvis
 SIZE, WINDOW, OVERLAP = 512, 32, 16
 
 
-def density_bump(n=64, width=0.2, amplitude=3.0, sigma_cells=8.0):
+def density_bump(n: int = 64, width: float = 0.2, amplitude: float = 3.0,
+                 sigma_cells: float = 8.0) -> Tuple[NDArray[np.float64], float, float]:
     """Air at 1.2 kg/m³ with a Gaussian bump of ``amplitude`` (relative),
     σ = ``sigma_cells`` cells, on an n³ grid ``width`` metres across,
     indexed ``[z, y, x]``."""
@@ -46,10 +49,10 @@ def density_bump(n=64, width=0.2, amplitude=3.0, sigma_cells=8.0):
     return rho, h, -c
 
 
-def openpiv_convention():
+def openpiv_convention() -> Tuple[float, float]:
     """OpenPIV's (u, v) for a pattern moved 2 px right and 1 px down:
     checked, not assumed, so a change in its convention shows here."""
-    from openpiv import pyprocess
+    from openpiv import pyprocess  # type: ignore[import-untyped]
 
     rng = np.random.default_rng(0)
     a = (rng.random((128, 128)) * 4000).astype(np.int32)
@@ -59,7 +62,8 @@ def openpiv_convention():
     return float(np.median(u)), float(np.median(v))
 
 
-def piv(reference, flow):
+def piv(reference: NDArray[Any], flow: NDArray[Any]
+        ) -> Tuple[NDArray[Any], NDArray[Any], NDArray[Any], NDArray[Any]]:
     """OpenPIV's vectors from ``reference`` to ``flow``: (x, y) window
     centres and (u, v) in pixels, x right and y down (see
     :func:`openpiv_convention`)."""
@@ -72,7 +76,7 @@ def piv(reference, flow):
     return x, y, u, v
 
 
-def window_means(truth, x, y):
+def window_means(truth: NDArray[np.float64], x: NDArray[Any], y: NDArray[Any]) -> NDArray[np.float64]:
     """The truth (h, w, 2) averaged over each interrogation window."""
     half = WINDOW // 2
     out = np.zeros(x.shape + (2,))
@@ -83,7 +87,7 @@ def window_means(truth, x, y):
     return out
 
 
-def compare(reference, flow, truth):
+def compare(reference: NDArray[Any], flow: NDArray[Any], truth: NDArray[np.float64]) -> Dict[str, Any]:
     """Correlation, rms difference (px) and the truth's largest |Δ| over
     the windows, OpenPIV's (u, v) against the window-averaged truth."""
     x, y, u, v = piv(reference, flow)
@@ -99,14 +103,14 @@ def compare(reference, flow, truth):
     }
 
 
-def record(image, noise, seed):
+def record(image: NDArray[np.float64], noise: bool, seed: int) -> NDArray[np.uint16]:
     """A 12-bit camera's counts of ``image`` (1 ≈ a dot's centre at 8000
     e⁻ of a 10 000 e⁻ well, as ``rt bos`` records)."""
-    kw = dict(shot_noise=True, read_noise=5.0) if noise else {}
+    kw: Dict[str, Any] = dict(shot_noise=True, read_noise=5.0) if noise else {}
     return rtvis.record(image, exposure=8000.0, full_well=10000.0, bits=12, seed=seed, **kw)
 
 
-def rtvis_case(noise):
+def rtvis_case(noise: bool) -> Dict[str, Any]:
     rho, h, origin = density_bump()
     vol = rtvis.Volume(rho, spacing=(h,) * 3, origin=(origin,) * 3, quantity="density")
     ref, flow, disp, info = rtvis.bos(vol, size=SIZE, seed=3)
@@ -115,7 +119,7 @@ def rtvis_case(noise):
     return result
 
 
-def rt_case(rt, noise, folder):
+def rt_case(rt: str, noise: bool, folder: Union[str, Path]) -> Dict[str, Any]:
     """The same bump written as raw + JSON and rendered by ``rt bos``; its
     12-bit PNGs and ``.raw`` truth read back."""
     import imageio.v3 as iio
@@ -140,7 +144,7 @@ def rt_case(rt, noise, folder):
     return result
 
 
-def closure(rt=None):
+def closure(rt: Optional[str] = None) -> List[Dict[str, Any]]:
     """Every case: a list of dicts (``case``, ``windows``, ``correlation``,
     ``rms_px``, ``max_truth_px``, ``set_up``)."""
     u, v = openpiv_convention()
@@ -156,7 +160,7 @@ def closure(rt=None):
     return rows
 
 
-def main(argv=None):
+def main(argv: Optional[Sequence[str]] = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--rt", help="the rt command, for the `rt bos` cases")
     p.add_argument("--json", help="also write the numbers here")

@@ -9,8 +9,10 @@ with a ring vortex at its head. Writes PNGs into the folder given (default
 import sys
 import time
 from pathlib import Path
+from typing import Callable, Dict
 
 import numpy as np
+from numpy.typing import NDArray
 
 import rtvis
 
@@ -31,7 +33,7 @@ rho = 1.2 - jet + ring
 
 vol = rtvis.Volume(rho, spacing=(h, h, h), origin=(-32 * h, -8 * h, -32 * h), interpolation="cubic")
 print(vol)
-images = {
+images: Dict[str, Callable[[], NDArray[np.uint8]]] = {
     "schlieren-knife.png": lambda: rtvis.to_gray8(rtvis.schlieren(vol, cutoff="knife", angle=0, size=384)),
     "schlieren-knife-vertical.png": lambda: rtvis.to_gray8(rtvis.schlieren(vol, cutoff="knife", angle=90, size=384)),
     "shadowgraph.png": lambda: rtvis.to_gray8(rtvis.shadowgraph(vol, size=384)),

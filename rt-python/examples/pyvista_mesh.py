@@ -27,7 +27,9 @@ print(f"{mesh.n_points} points, {len(triangles)} triangles, RTData {scalars.min(
 scene = rtvis.Scene()
 scene.add_mesh(mesh.points, triangles, scalars=scalars, colormap="cool_to_warm", material="glossy")
 # A floor under it, to catch the shadows.
-(lo, hi) = scene.bounds()
+bounds = scene.bounds()
+assert bounds is not None
+(lo, hi) = bounds
 y0 = lo[1] - 0.5
 floor = np.array([[-30, y0, -30], [30, y0, -30], [30, y0, 30], [-30, y0, 30]], dtype=np.float32)
 scene.add_mesh(floor, [[0, 2, 1], [0, 3, 2]], color=(0.8, 0.8, 0.8), material="matte")

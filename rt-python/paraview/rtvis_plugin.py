@@ -1,4 +1,5 @@
-"""ParaView filters backed by rtvis: RT Schlieren and RT Surface Render.
+"""ParaView filters backed by rtvis: RT Schlieren, RT BOS, RT Focusing
+Schlieren and RT Surface Render.
 
 Load with Tools → Manage Plugins → Load New (this file), or put this
 folder on ``PV_PLUGIN_PATH`` to load it at start-up, or from Python::
@@ -25,6 +26,7 @@ from paraview.util.vtkAlgorithm import smdomain, smhint, smproperty, smproxy
 from vtkmodules.numpy_interface import dataset_adapter as dsa
 from vtkmodules.util import numpy_support
 from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase
+from vtkmodules.vtkCommonCore import vtkStringArray
 from vtkmodules.vtkCommonDataModel import vtkDataObject, vtkDataSet, vtkImageData, vtkPolyData
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
 from vtkmodules.vtkFiltersCore import vtkTriangleFilter
@@ -101,33 +103,30 @@ def _world():
     return comm.Get_rank(), comm.Get_size(), comm
 
 
-@smproxy.filter(name="RTSchlieren", label="RT Schlieren")
-@smhint.xml('<ShowInMenu category="rt"/>')
-@smproperty.input(name="Input", port_index=0)
-@smdomain.datatype(dataTypes=["vtkImageData"], composite_data_supported=False)
-@smdomain.xml('<InputArrayDomain name="input_array" number_of_components="1"/>')
-class RTSchlieren(VTKPythonAlgorithmBase):
-    """Synthetic schlieren, shadowgraph, interferogram or colour schlieren
-    of a volume (density or refractive index) by rtvis: photons traced
-    along curved paths through the field. Output: a 2-D image with
-    ``Intensity`` (1 = undisturbed background; ``RGB`` for the colour
-    filter), ``Deflection`` (radians, along the image's axes) and, for
-    interferometry, ``Phase`` (radians, unwrapped)."""
+class _Aborted(Exception):
+    """ParaView asked the filter to abort (its progress bar's button)."""
 
-    def __init__(self):
-        VTKPythonAlgorithmBase.__init__(self, nInputPorts=1, nOutputPorts=1, outputType="vtkImageData")
-        self._quantity, self._k, self._cutoff, self._angle = 0, 2.26e-4, 0, 0.0
-        self._f, self._h, self._film, self._wavelength, self._fringes = 1.0, 0.0, 0.0, 10.6e-6, 0.0
-        self._axis, self._size, self._photons, self._seed, self._cubic = 2, 512, 16, 1, 1
-        self._nonphysical = 0
+
+class _VolumeInput:
+    """What every optics filter shares: the volume (array, quantity,
+    interpolation), the view (axis, size, seed), the image's geometry,
+    progress and abort, and the optics it chose (shown, and locked
+    across a time series on request). The properties are declared once
+    here and copied into each filter's class (``_volume_filter``), since
+    ParaView reads a proxy's properties from the class's own dict."""
+
+    _quantity, _k, _cubic, _nonphysical, _axis, _size, _seed = 0, 2.26e-4, 1, 0, 2, 512, 1
+    _lock, _locked, _chosen = 0, None, ""
 
     def _set(self, name, value):
         if getattr(self, name) != value:
             setattr(self, name, value)
+            self._locked = None  # other optics: choose again
             self.Modified()
 
     @_array_selection("Array", "Scalars", "The volume's scalar: density (kg/m³) or refractive index.")
     def SetInputArrayToProcess(self, idx, port, connection, field, name):
+        self._locked = None
         return VTKPythonAlgorithmBase.SetInputArrayToProcess(self, idx, port, connection, field, name)
 
     @_enum("Quantity", "SetQuantity", ["Density (Gladstone-Dale)", "Refractive index"], 0,
@@ -140,6 +139,177 @@ class RTSchlieren(VTKPythonAlgorithmBase):
     @_doc("Gladstone–Dale constant K in m³/kg (n = 1 + K·ρ); 2.26e-4 is air at visible wavelengths. Used for density only.")
     def SetK(self, v):
         self._set("_k", float(v))
+
+    @_enum("Axis", "SetAxis", ["x", "y", "z"], 2, "Beam direction.")
+    def SetAxis(self, v):
+        self._set("_axis", int(v))
+
+    @smproperty.intvector(name="Size", default_values=[512])
+    @smdomain.intrange(min=1, max=16384)
+    @_doc("Image width in pixels (the height follows the volume's aspect).")
+    def SetSize(self, v):
+        self._set("_size", int(v))
+
+    @smproperty.intvector(name="Seed", default_values=[1])
+    @_doc("Random seed of the photon jitter: the same seed gives the same image, bit for bit, at any thread count.")
+    def SetSeed(self, v):
+        self._set("_seed", int(v))
+
+    @_enum("Interpolation", "SetInterpolation", ["Trilinear", "Catmull-Rom cubic"], 1,
+           "Interpolation between samples: Catmull-Rom (C1, smooth shadowgraphs) by default; "
+           "trilinear is about twice as fast but its gradient jumps at cell faces.")
+    def SetInterpolation(self, v):
+        self._set("_cubic", int(v))
+
+    @smproperty.intvector(name="AllowNonphysical", default_values=[0])
+    @smdomain.xml('<BooleanDomain name="bool"/>')
+    @_doc("Accept samples no gas has (negative density, an index below 1) instead of refusing the volume.")
+    def SetAllowNonphysical(self, v):
+        self._set("_nonphysical", int(v))
+
+    @smproperty.intvector(name="LockExposure", default_values=[0])
+    @smdomain.xml('<BooleanDomain name="bool"/>')
+    @_doc("Keep the optics chosen automatically (knife-edge height, film distance, grid pitch, …) from the next render on, across the time steps of a series, instead of choosing them per step (which flickers). Changing another property chooses again.")
+    def SetLockExposure(self, v):
+        v = int(v)
+        if v != self._lock:
+            self._lock, self._locked = v, None
+            self.Modified()
+
+    @smproperty.xml('<StringVectorProperty name="ChosenOptics" command="GetChosenOptics" '
+                    'information_only="1" number_of_elements="1"><SimpleStringInformationHelper/>'
+                    "<Documentation>The optics the last render used, automatic choices made explicit.</Documentation>"
+                    "</StringVectorProperty>")
+    def GetChosenOptics(self):
+        return self._chosen
+
+    def _geometry(self, in_info):
+        """(dims, origin, spacing) of the samples: points, or cell centres
+        for cell data; and the image's (w, h, pixel size, origin) over the
+        volume's cross-section."""
+        info = in_info[0].GetInformationObject(0)
+        ext = info.Get(vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT())
+        spacing = np.array(info.Get(vtkDataObject.SPACING()), dtype=np.float64)
+        origin = np.array(info.Get(vtkDataObject.ORIGIN()), dtype=np.float64)
+        dims = np.array([ext[1] - ext[0] + 1, ext[3] - ext[2] + 1, ext[5] - ext[4] + 1])
+        origin = origin + spacing * np.array([ext[0], ext[2], ext[4]])
+        arr_info = self.GetInputArrayInformation(0)
+        if arr_info.Get(vtkDataObject.FIELD_ASSOCIATION()) == vtkDataObject.FIELD_ASSOCIATION_CELLS:
+            dims = np.maximum(dims - 1, 1)
+            origin = origin + 0.5 * spacing
+        lo, hi = origin - 0.5 * spacing, origin + (dims - 0.5) * spacing  # as rt's Grid::bounds
+        u, v = {0: (1, 2), 1: (2, 0), 2: (0, 1)}[self._axis]
+        width, height = hi[u] - lo[u], hi[v] - lo[v]
+        w = self._size
+        h = max(1, int(math.floor(w * height / width + 0.5)))
+        px = (width / w, height / h)
+        return dims, origin, spacing, (w, h, px, (lo[u] + 0.5 * px[0], lo[v] + 0.5 * px[1]))
+
+    def RequestInformation(self, request, in_info, out_info):
+        *_, (w, h, px, o) = self._geometry(in_info)
+        _image_output(out_info, w, h, px, o)
+        return 1
+
+    def RequestUpdateExtent(self, request, in_info, out_info):
+        # The whole volume, whatever part of the image is asked for.
+        info = in_info[0].GetInformationObject(0)
+        info.Set(vtkStreamingDemandDrivenPipeline.UPDATE_EXTENT(),
+                 info.Get(vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT()), 6)
+        return 1
+
+    def _volume(self, in_info, label):
+        """The rtvis.Volume of the chosen array; the image's geometry."""
+        import rtvis
+
+        dims, origin, spacing, image = self._geometry(in_info)
+        array = _selected_array(self, vtkImageData.GetData(in_info[0], 0))
+        if array is None:
+            raise ValueError(f"{label}: choose a scalar array (Array)")
+        values = numpy_support.vtk_to_numpy(array).reshape(dims[2], dims[1], dims[0])
+        try:
+            vol = rtvis.Volume(values, spacing=tuple(spacing), origin=tuple(origin),
+                               quantity=["density", "index"][self._quantity], k=self._k,
+                               interpolation=["linear", "cubic"][self._cubic],
+                               allow_nonphysical=bool(self._nonphysical))
+        except ValueError as e:
+            # rtvis names its keywords; here they are properties.
+            raise ValueError(f"{label}: {e} (here: check Quantity, or tick Allow Nonphysical)") from e
+        return vol, image
+
+    def _progress(self, done, total):
+        """rtvis's progress callback: ParaView's progress bar, its abort."""
+        self.UpdateProgress(done / total if total else 1.0)
+        if self.GetAbortExecute():
+            raise _Aborted()
+
+    def _render(self, render, vol, options, progress=True):
+        """``render(vol, **options)`` with the locked optics if any (else
+        choosing them, and locking them when asked), reporting progress
+        to ParaView and honouring its abort (where the render counts its
+        work: the schlieren family); ``None`` if aborted."""
+        if self._lock and self._locked is not None:
+            options = {**options, **self._locked}
+        if progress:
+            options = {**options, "progress": self._progress}
+        try:
+            *out, chosen = render(vol, chosen=True, **options)
+        except _Aborted:
+            return None
+        if self._lock and self._locked is None:
+            self._locked = dict(chosen)
+        self._chosen = chosen.description
+        return out
+
+    def _image(self, out_info, image, arrays, label):
+        """The output image over the volume's cross-section: ``arrays``
+        ``(name, (h, w[, c]) array)``, the first one active, and the
+        chosen optics as field data."""
+        w, h, px, o = image
+        out = vtkImageData.GetData(out_info)
+        out.SetExtent(0, w - 1, 0, h - 1, 0, 0)
+        out.SetSpacing(px[0], px[1], 1.0)
+        out.SetOrigin(o[0], o[1], 0.0)
+        for i, (name, values) in enumerate(arrays):
+            if values.shape[:2] != (h, w):
+                raise RuntimeError(f"{label}: image {values.shape[:2]} differs from the announced {(h, w)}")
+            arr = _add_array(out, name, values, values.shape[2] if values.ndim == 3 else 1)
+            if i == 0:
+                out.GetPointData().SetScalars(arr)
+        said = vtkStringArray()
+        said.SetName("ChosenOptics")
+        said.InsertNextValue(self._chosen)
+        out.GetFieldData().AddArray(said)
+        return 1
+
+
+def _volume_filter(cls):
+    """Copies the shared properties into ``cls``'s own dict (see
+    :class:`_VolumeInput`), ahead of ParaView's proxy decorator."""
+    for name, value in vars(_VolumeInput).items():
+        if callable(value) and name.startswith(("Set", "Get")) and name not in vars(cls):
+            setattr(cls, name, value)
+    return cls
+
+
+@smproxy.filter(name="RTSchlieren", label="RT Schlieren")
+@smhint.xml('<ShowInMenu category="rt"/>')
+@smproperty.input(name="Input", port_index=0)
+@smdomain.datatype(dataTypes=["vtkImageData"], composite_data_supported=False)
+@smdomain.xml('<InputArrayDomain name="input_array" number_of_components="1"/>')
+@_volume_filter
+class RTSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
+    """Synthetic schlieren, shadowgraph, interferogram or colour schlieren
+    of a volume (density or refractive index) by rtvis: photons traced
+    along curved paths through the field. Output: a 2-D image with
+    ``Intensity`` (1 = undisturbed background; ``RGB`` for the colour
+    filter), ``Deflection`` (radians, along the image's axes) and, for
+    interferometry, ``Phase`` (radians, unwrapped)."""
+
+    def __init__(self):
+        VTKPythonAlgorithmBase.__init__(self, nInputPorts=1, nOutputPorts=1, outputType="vtkImageData")
+        self._cutoff, self._angle = 0, 0.0
+        self._f, self._h, self._film, self._wavelength, self._fringes = 1.0, 0.0, 0.0, 10.6e-6, 0.0
+        self._photons = 16
 
     @_enum("Cutoff", "SetCutoff", ["Knife edge", "Graded filter", "Pinhole", "Dark field", "Colour (hue wheel)",
                                    "None (shadowgraph)", "Interferometry"], 0, "The optical set-up.")
@@ -178,111 +348,198 @@ class RTSchlieren(VTKPythonAlgorithmBase):
     def SetFringeSpacing(self, v):
         self._set("_fringes", float(v))
 
-    @_enum("Axis", "SetAxis", ["x", "y", "z"], 2, "Beam direction.")
-    def SetAxis(self, v):
-        self._set("_axis", int(v))
-
-    @smproperty.intvector(name="Size", default_values=[512])
-    @smdomain.intrange(min=1, max=16384)
-    @_doc("Image width in pixels (the height follows the volume's aspect).")
-    def SetSize(self, v):
-        self._set("_size", int(v))
-
     @smproperty.intvector(name="Photons", default_values=[16])
     @smdomain.intrange(min=1, max=65536)
     @_doc("Photons traced per pixel (jittered): more is smoother, time grows with it.")
     def SetPhotons(self, v):
         self._set("_photons", int(v))
 
-    @smproperty.intvector(name="Seed", default_values=[1])
-    @_doc("Random seed of the photon jitter: the same seed gives the same image, bit for bit, at any thread count.")
-    def SetSeed(self, v):
-        self._set("_seed", int(v))
-
-    @_enum("Interpolation", "SetInterpolation", ["Trilinear", "Catmull-Rom cubic"], 1,
-           "Interpolation between samples: Catmull-Rom (C1, smooth shadowgraphs) by default; "
-           "trilinear is about twice as fast but its gradient jumps at cell faces.")
-    def SetInterpolation(self, v):
-        self._set("_cubic", int(v))
-
-    @smproperty.intvector(name="AllowNonphysical", default_values=[0])
-    @smdomain.xml('<BooleanDomain name="bool"/>')
-    @_doc("Accept samples no gas has (negative density, an index below 1) instead of refusing the volume.")
-    def SetAllowNonphysical(self, v):
-        self._set("_nonphysical", int(v))
-
-    def _geometry(self, in_info):
-        """(dims, origin, spacing) of the samples: points, or cell centres
-        for cell data; and the image's (w, h, pixel size, origin)."""
-        info = in_info[0].GetInformationObject(0)
-        ext = info.Get(vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT())
-        spacing = np.array(info.Get(vtkDataObject.SPACING()), dtype=np.float64)
-        origin = np.array(info.Get(vtkDataObject.ORIGIN()), dtype=np.float64)
-        dims = np.array([ext[1] - ext[0] + 1, ext[3] - ext[2] + 1, ext[5] - ext[4] + 1])
-        origin = origin + spacing * np.array([ext[0], ext[2], ext[4]])
-        arr_info = self.GetInputArrayInformation(0)
-        if arr_info.Get(vtkDataObject.FIELD_ASSOCIATION()) == vtkDataObject.FIELD_ASSOCIATION_CELLS:
-            dims = np.maximum(dims - 1, 1)
-            origin = origin + 0.5 * spacing
-        lo, hi = origin - 0.5 * spacing, origin + (dims - 0.5) * spacing  # as rt's Grid::bounds
-        u, v = {0: (1, 2), 1: (2, 0), 2: (0, 1)}[self._axis]
-        width, height = hi[u] - lo[u], hi[v] - lo[v]
-        w = self._size
-        h = max(1, int(math.floor(w * height / width + 0.5)))
-        px = (width / w, height / h)
-        return dims, origin, spacing, (w, h, px, (lo[u] + 0.5 * px[0], lo[v] + 0.5 * px[1]))
-
-    def RequestInformation(self, request, in_info, out_info):
-        *_, (w, h, px, o) = self._geometry(in_info)
-        _image_output(out_info, w, h, px, o)
-        return 1
-
-    def RequestUpdateExtent(self, request, in_info, out_info):
-        # The whole volume, whatever part of the image is asked for.
-        info = in_info[0].GetInformationObject(0)
-        info.Set(vtkStreamingDemandDrivenPipeline.UPDATE_EXTENT(),
-                 info.Get(vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT()), 6)
-        return 1
-
     def RequestData(self, request, in_info, out_info):
         import rtvis
 
-        dims, origin, spacing, (w, h, px, o) = self._geometry(in_info)
-        array = _selected_array(self, vtkImageData.GetData(in_info[0], 0))
-        if array is None:
-            raise ValueError("RT Schlieren: choose a scalar array (Array)")
-        values = numpy_support.vtk_to_numpy(array).reshape(dims[2], dims[1], dims[0])
-        try:
-            vol = rtvis.Volume(values, spacing=tuple(spacing), origin=tuple(origin),
-                               quantity=["density", "index"][self._quantity], k=self._k,
-                               interpolation=["linear", "cubic"][self._cubic],
-                               allow_nonphysical=bool(self._nonphysical))
-        except ValueError as e:
-            # rtvis names its keywords; here they are properties.
-            raise ValueError(f"RT Schlieren: {e} (here: check Quantity, or tick Allow Nonphysical)") from e
+        vol, image = self._volume(in_info, "RT Schlieren")
         cutoff = _CUTOFFS[self._cutoff]
         common = dict(axis=_AXES[self._axis], size=self._size, photons=self._photons, seed=self._seed,
                       deflection=True)
         if cutoff == "none":
-            img, eps = rtvis.shadowgraph(vol, distance=self._film or None, **common)
+            out = self._render(rtvis.shadowgraph, vol, dict(distance=self._film or None, **common))
         elif cutoff == "interferometry":
-            img, eps, phase = rtvis.interferogram(vol, wavelength=self._wavelength,
-                                                  fringe_spacing=self._fringes or None, phase=True, **common)
+            out = self._render(rtvis.interferogram, vol, dict(
+                wavelength=self._wavelength, fringe_spacing=self._fringes or None, phase=True, **common))
         else:
-            img, eps = rtvis.schlieren(vol, cutoff=cutoff, angle=self._angle, f=self._f,
-                                       h=self._h or None, film_distance=self._film, **common)
-        out = vtkImageData.GetData(out_info)
-        out.SetExtent(0, w - 1, 0, h - 1, 0, 0)
-        out.SetSpacing(px[0], px[1], 1.0)
-        out.SetOrigin(o[0], o[1], 0.0)
-        if img.shape[:2] != (h, w):
-            raise RuntimeError(f"RT Schlieren: image {img.shape[:2]} differs from the announced {(h, w)}")
-        main = _add_array(out, "RGB" if img.ndim == 3 else "Intensity", img, img.shape[2] if img.ndim == 3 else 1)
-        _add_array(out, "Deflection", eps, 2)
-        if cutoff == "interferometry":
-            _add_array(out, "Phase", phase, 1)
-        out.GetPointData().SetScalars(main)
-        return 1
+            out = self._render(rtvis.schlieren, vol, dict(
+                cutoff=cutoff, angle=self._angle, f=self._f, h=self._h or None, film_distance=self._film,
+                **common))
+        if out is None:
+            return 1
+        img, eps, *phase = out
+        arrays = [("RGB" if img.ndim == 3 else "Intensity", img), ("Deflection", eps)]
+        arrays += [("Phase", p) for p in phase]
+        return self._image(out_info, image, arrays, "RT Schlieren")
+
+
+@smproxy.filter(name="RTBOS", label="RT BOS")
+@smhint.xml('<ShowInMenu category="rt"/>')
+@smproperty.input(name="Input", port_index=0)
+@smdomain.datatype(dataTypes=["vtkImageData"], composite_data_supported=False)
+@smdomain.xml('<InputArrayDomain name="input_array" number_of_components="1"/>')
+@_volume_filter
+class RTBOS(_VolumeInput, VTKPythonAlgorithmBase):
+    """Background-oriented schlieren of a volume by rtvis, set up as ``rt
+    bos`` sets it up (a laboratory rig where left at 0). Output: an image
+    with ``Displacement`` (the background's apparent motion from the
+    reference to the flow image, pixels, x right and y up as shown),
+    ``Flow`` and ``Reference`` (the background seen with and without the
+    flow, 0–1), placed over the volume's cross-section."""
+
+    def __init__(self):
+        VTKPythonAlgorithmBase.__init__(self, nInputPorts=1, nOutputPorts=1, outputType="vtkImageData")
+        self._background, self._fnumber, self._focal, self._pixel = 0, 16.0, 0.0, 0.0
+        self._distance, self._zd, self._dot, self._spacing, self._samples = 0.0, 0.0, 3.0, 4.0, 2
+
+    @_enum("Background", "SetBackground", ["Random dots", "Grid of dots"], 0, "The background pattern.")
+    def SetBackground(self, v):
+        self._set("_background", int(v))
+
+    @smproperty.doublevector(name="FNumber", default_values=[16.0])
+    @smdomain.doublerange(min=0.0)
+    @_doc("The lens's f-number N (dimensionless): larger keeps the background sharp through the flow.")
+    def SetFNumber(self, v):
+        self._set("_fnumber", float(v))
+
+    @smproperty.doublevector(name="FocalLength", default_values=[0.0])
+    @_doc("The lens's focal length in metres. 0: the usual lens that fills the image with the volume about 1.5 m away.")
+    def SetFocalLength(self, v):
+        self._set("_focal", float(v))
+
+    @smproperty.doublevector(name="PixelPitch", default_values=[0.0])
+    @_doc("The sensor's pixel pitch in metres. 0: a 2048 × 5.5 µm sensor binned to Size pixels.")
+    def SetPixelPitch(self, v):
+        self._set("_pixel", float(v))
+
+    @smproperty.doublevector(name="CameraDistance", default_values=[0.0])
+    @_doc("From the lens to the volume's centre (Z_A), metres. 0: chosen with the lens.")
+    def SetCameraDistance(self, v):
+        self._set("_distance", float(v))
+
+    @smproperty.doublevector(name="BackgroundDistance", default_values=[0.0])
+    @_doc("From the volume's centre to the background (Z_D), metres. 0: chosen so the strongest 1 % of deflections move the background 4 pixels.")
+    def SetBackgroundDistance(self, v):
+        self._set("_zd", float(v))
+
+    @smproperty.doublevector(name="Dot", default_values=[3.0])
+    @_doc("Dot diameter as imaged, pixels.")
+    def SetDot(self, v):
+        self._set("_dot", float(v))
+
+    @smproperty.doublevector(name="DotSpacing", default_values=[4.0])
+    @_doc("Mean dot spacing as imaged, pixels.")
+    def SetDotSpacing(self, v):
+        self._set("_spacing", float(v))
+
+    @smproperty.intvector(name="Samples", default_values=[2])
+    @smdomain.intrange(min=1, max=64)
+    @_doc("k: k² aperture samples per pixel (the lens's blur).")
+    def SetSamples(self, v):
+        self._set("_samples", int(v))
+
+    def RequestData(self, request, in_info, out_info):
+        import rtvis
+
+        vol, image = self._volume(in_info, "RT BOS")
+        options = dict(axis=_AXES[self._axis], size=self._size, seed=self._seed, f_number=self._fnumber,
+                       focal_length=self._focal or None, pixel=self._pixel or None,
+                       distance=self._distance or None, background_distance=self._zd or None, dot=self._dot,
+                       spacing=self._spacing, samples=self._samples,
+                       background=["random", "grid"][self._background])
+        out = self._render(rtvis.bos, vol, options, progress=False)
+        if out is None:
+            return 1
+        reference, flow, disp, _ = out
+        shown = np.stack([disp[..., 0], -disp[..., 1]], axis=-1)  # y up, as ParaView shows the image
+        return self._image(out_info, image, [("Displacement", shown), ("Flow", flow), ("Reference", reference)],
+                           "RT BOS")
+
+
+@smproxy.filter(name="RTFocusingSchlieren", label="RT Focusing Schlieren")
+@smhint.xml('<ShowInMenu category="rt"/>')
+@smproperty.input(name="Input", port_index=0)
+@smdomain.datatype(dataTypes=["vtkImageData"], composite_data_supported=False)
+@smdomain.xml('<InputArrayDomain name="input_array" number_of_components="1"/>')
+@_volume_filter
+class RTFocusingSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
+    """Focusing schlieren (a lens-and-grid system) of a volume by rtvis,
+    set up as ``rt focusing`` sets it up. Output: an image with
+    ``Relative`` (I/I₀: 1 undisturbed), ``Flow`` and ``Reference``,
+    placed over the volume's cross-section."""
+
+    def __init__(self):
+        VTKPythonAlgorithmBase.__init__(self, nInputPorts=1, nOutputPorts=1, outputType="vtkImageData")
+        self._focus, self._aperture, self._focal, self._source, self._pitch = 0.0, 0.0, 0.0, 0.0, 0.0
+        self._duty, self._angle, self._offset, self._samples = 0.5, 0.0, 0.25, 6
+
+    @smproperty.doublevector(name="Focus", default_values=[0.0])
+    @_doc("The plane in focus: its distance from the volume's centre toward the lens, metres (negative: beyond the centre).")
+    def SetFocus(self, v):
+        self._set("_focus", float(v))
+
+    @smproperty.doublevector(name="Aperture", default_values=[0.0])
+    @_doc("The lens's diameter, metres; larger focuses more sharply. 0: f/2.")
+    def SetAperture(self, v):
+        self._set("_aperture", float(v))
+
+    @smproperty.doublevector(name="FocalLength", default_values=[0.0])
+    @_doc("The schlieren lens's focal length, metres. 0: a quarter of the camera distance.")
+    def SetFocalLength(self, v):
+        self._set("_focal", float(v))
+
+    @smproperty.doublevector(name="SourceDistance", default_values=[0.0])
+    @_doc("From the lens to the source grid, metres, beyond the focus plane. 0: twice the focus plane's distance.")
+    def SetSourceDistance(self, v):
+        self._set("_source", float(v))
+
+    @smproperty.doublevector(name="Pitch", default_values=[0.0])
+    @_doc("The source grid's period on its plane, metres. 0: chosen from the flow (the strongest 1 % of deflections use 80 % of the linear range).")
+    def SetPitch(self, v):
+        self._set("_pitch", float(v))
+
+    @smproperty.doublevector(name="Duty", default_values=[0.5])
+    @smdomain.doublerange(min=0.0, max=1.0)
+    @_doc("Bright fraction of each grid period (dimensionless, between 0 and 1).")
+    def SetDuty(self, v):
+        self._set("_duty", float(v))
+
+    @smproperty.doublevector(name="Angle", default_values=[0.0])
+    @_doc("Band orientation in degrees: 0, bands along the image's vertical (sensitive to horizontal deflection).")
+    def SetAngle(self, v):
+        self._set("_angle", float(v))
+
+    @smproperty.doublevector(name="Offset", default_values=[0.25])
+    @smdomain.doublerange(min=0.0, max=1.0)
+    @_doc("The cutoff grid's shift across the bands, in pitches (0 is dark field).")
+    def SetOffset(self, v):
+        self._set("_offset", float(v))
+
+    @smproperty.intvector(name="Samples", default_values=[6])
+    @smdomain.intrange(min=1, max=64)
+    @_doc("k: k² aperture samples per pixel.")
+    def SetSamples(self, v):
+        self._set("_samples", int(v))
+
+    def RequestData(self, request, in_info, out_info):
+        import rtvis
+
+        vol, image = self._volume(in_info, "RT Focusing Schlieren")
+        options = dict(axis=_AXES[self._axis], size=self._size, seed=self._seed, focus=self._focus,
+                       aperture=self._aperture or None, focal_length=self._focal or None,
+                       source_distance=self._source or None, pitch=self._pitch or None, duty=self._duty,
+                       angle=self._angle, offset=self._offset, samples=self._samples)
+        out = self._render(rtvis.focusing, vol, options, progress=False)
+        if out is None:
+            return 1
+        reference, flow, relative, _ = out
+        return self._image(out_info, image, [("Relative", relative), ("Flow", flow), ("Reference", reference)],
+                           "RT Focusing Schlieren")
 
 
 @smproxy.filter(name="RTSurfaceRender", label="RT Surface Render")

@@ -246,9 +246,15 @@ pub(crate) fn record<'py>(
 }
 
 /// `(reference [h, w], flow [h, w], displacement [h, w, 2] in pixels (x
-/// right, y down), a line describing the set-up)`.
-type BosOut<'py> =
-    (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray3<f64>>, String);
+/// right, y down), a line describing the set-up, the rig chosen by
+/// `rtvis.bos`'s keywords)`.
+type BosOut<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray3<f64>>,
+    String,
+    Bound<'py, PyDict>,
+);
 
 /// Background-oriented schlieren of `volume` ([`BosSetup`]); the
 /// background is `"random"`, `"grid"`, the path of a PNG image, or
@@ -326,18 +332,29 @@ pub(crate) fn bos<'py>(
         c.f_number * (1.0 + c.magnification()),
     );
     let disp: Vec<f64> = images.displacement.iter().flatten().copied().collect();
+    let chosen = PyDict::new(py);
+    chosen.set_item("focal_length", rig.focal_length)?;
+    chosen.set_item("pixel", rig.pixel_pitch)?;
+    chosen.set_item("distance", rig.camera_distance)?;
+    chosen.set_item("background_distance", rig.background_distance)?;
     Ok((
         Array2::from_shape_vec((h, w), images.reference).map_err(value_error)?.into_pyarray(py),
         Array2::from_shape_vec((h, w), images.flow).map_err(value_error)?.into_pyarray(py),
         Array3::from_shape_vec((h, w, 2), disp).map_err(value_error)?.into_pyarray(py),
         said,
+        chosen,
     ))
 }
 
 /// `(reference [h, w], flow [h, w], I/I₀ [h, w], a line describing the
-/// set-up)`.
-type FocusingOut<'py> =
-    (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>, String);
+/// set-up, the rig chosen by `rtvis.focusing`'s keywords)`.
+type FocusingOut<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    String,
+    Bound<'py, PyDict>,
+);
 
 /// Focusing schlieren of `volume` ([`FocusingSetup`]).
 #[pyfunction]
@@ -412,10 +429,18 @@ pub(crate) fn focusing<'py>(
         c.pixel_pitch
     );
     let relative = images.relative();
+    let chosen = PyDict::new(py);
+    chosen.set_item("focal_length", c.focal_length)?;
+    chosen.set_item("aperture", c.aperture())?;
+    chosen.set_item("pixel", c.pixel_pitch)?;
+    chosen.set_item("distance", setup.rig.camera_distance)?;
+    chosen.set_item("source_distance", fs.source_distance)?;
+    chosen.set_item("pitch", fs.grid.pitch)?;
     Ok((
         Array2::from_shape_vec((h, w), images.reference).map_err(value_error)?.into_pyarray(py),
         Array2::from_shape_vec((h, w), images.flow).map_err(value_error)?.into_pyarray(py),
         Array2::from_shape_vec((h, w), relative).map_err(value_error)?.into_pyarray(py),
         said,
+        chosen,
     ))
 }

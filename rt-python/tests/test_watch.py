@@ -48,6 +48,19 @@ def test_chosen_optics_repeat_the_render_on_other_data():
     assert img.shape == (32, 32) and eps.shape == (32, 32, 2) and phi.shape == (32, 32)
 
 
+def test_bos_and_focusing_return_the_rig_they_chose():
+    vol, _, _ = bump(n=32, delta=1e-4)
+    *images, info, chosen = rtvis.bos(vol, size=32, chosen=True)
+    assert isinstance(chosen, rtvis.Optics) and chosen.description == info
+    assert {"focal_length", "pixel", "distance", "background_distance"} <= set(chosen)
+    again = rtvis.bos(vol, **chosen)
+    assert all(np.array_equal(a, b) for a, b in zip(images, again[:3]))
+    *images, info, chosen = rtvis.focusing(vol, size=32, samples=2, chosen=True)
+    assert chosen.pitch > 0 and chosen.aperture > 0
+    again = rtvis.focusing(vol, **chosen)
+    assert all(np.array_equal(a, b) for a, b in zip(images, again[:3]))
+
+
 def test_progress_is_reported_on_the_calling_thread_up_to_the_total(capsys):
     import threading
 

@@ -1,4 +1,4 @@
-"""pvpython test of both filters (run by run-tests.sh): the plugin loads on
+"""pvpython test of the filters (run by run-tests.sh): the plugin loads on
 a stock ParaView 5.11 + Python 3.11 (through rtvis_pvcompat), RT Schlieren
 turns a vtkImageData of density into the same image rtvis makes from the
 same samples, and RT Surface Render draws a contour.
@@ -66,6 +66,56 @@ fringes = arrays(RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=6, 
 assert fringes["Phase"].shape == (64, 64) and fringes["Phase"].max() > 2 * np.pi
 print("RT Schlieren colour, shadowgraph and interferogram (with its phase): ok")
 
+# BOS and focusing schlieren: the same images as rtvis's from the same
+# samples (the displacement shown y up), the chosen optics shown. The
+# grid's unit is a metre here: a strong bump deflects enough to see.
+strong = Calculator(Input=src, ResultArrayName="density",
+                    Function="1.2 + 30*exp(-((coordsX)^2+(coordsY)^2+(coordsZ)^2)/(2*8^2))")
+strong.UpdatePipeline()
+rho_strong = numpy_support.vtk_to_numpy(
+    strong.GetClientSideObject().GetOutputDataObject(0).GetPointData().GetArray("density")).reshape(48, 48, 48)
+vol = rtvis.Volume(rho_strong, spacing=(1.0, 1.0, 1.0), origin=(-24.0, -24.0, -24.0))
+bos = RTBOS(Input=strong, Array=["POINTS", "density"], Size=64, Background=1)
+got = arrays(bos)
+ref, flow, disp, _ = rtvis.bos(vol, size=64, background="grid")
+assert np.array_equal(got["Flow"], flow) and np.array_equal(got["Reference"], ref)
+assert np.array_equal(got["Displacement"][..., 0], disp[..., 0])
+assert np.array_equal(got["Displacement"][..., 1], -disp[..., 1])
+assert np.abs(disp).max() > 0.5, np.abs(disp).max()
+bos.UpdatePropertyInformation()
+assert bos.GetPropertyValue("ChosenOptics").startswith("f/16"), bos.GetPropertyValue("ChosenOptics")
+focus = RTFocusingSchlieren(Input=strong, Array=["POINTS", "density"], Size=48, Samples=3)
+got = arrays(focus)
+assert np.array_equal(got["Relative"], rtvis.focusing(vol, size=48, samples=3)[2])
+assert got["Relative"].std() > 1e-3
+rtvis.save_png(os.path.join(out_dir, "paraview-bos.png"), rtvis.to_gray8(got["Relative"], white=2.0))
+print("RT BOS and RT Focusing Schlieren: equal to rtvis.bos and rtvis.focusing")
+
+# A time series with the exposure locked: the second step keeps the
+# first step's knife edge (a stronger flow then shows more contrast)
+# where the automatic exposure would choose again.
+weak = Calculator(Input=src, ResultArrayName="density",
+                  Function="1.2 + 0.15*exp(-((coordsX*0.001)^2+(coordsY*0.001)^2+(coordsZ*0.001)^2)/(2*0.008^2))")
+locked = RTSchlieren(Input=weak, Array=["POINTS", "density"], Size=48, Photons=4, LockExposure=1)
+first = arrays(locked)["Intensity"]
+locked.UpdatePropertyInformation()
+chosen_first = locked.GetPropertyValue("ChosenOptics")
+locked.Input = bump  # the next time step: the same property values
+second = arrays(locked)["Intensity"]
+locked.UpdatePropertyInformation()
+assert locked.GetPropertyValue("ChosenOptics") == chosen_first, (chosen_first, locked.GetPropertyValue("ChosenOptics"))
+auto = arrays(RTSchlieren(Input=bump, Array=["POINTS", "density"], Size=48, Photons=4))["Intensity"]
+assert np.abs(second - 1).mean() > 1.5 * np.abs(auto - 1).mean(), "the locked exposure was chosen again"
+print(f"LockExposure: {chosen_first} kept across the series")
+
+# Progress reaches ParaView (vtkCommand ProgressEvent, up to 1).
+seen = []
+algorithm = RTSchlieren(Input=bump, Array=["POINTS", "density"], Size=64, Photons=16)
+algorithm.GetClientSideObject().AddObserver("ProgressEvent", lambda o, e: seen.append(o.GetProgress()))
+arrays(algorithm)
+assert seen and max(seen) == 1.0 and len(set(seen)) > 2, seen
+print(f"progress: {len(seen)} reports up to {max(seen)}")
+
 contour = Contour(Input=Wavelet(), ContourBy=["POINTS", "RTData"], Isosurfaces=[130.0, 200.0])
 elev = Calculator(Input=contour, ResultArrayName="height", Function="coordsY")
 surface = RTSurfaceRender(Input=elev, ColorArray=["POINTS", "height"], ImageSize=[320, 240],
@@ -81,7 +131,8 @@ print(f"RT Surface Render: 320×240, {hit.mean():.0%} of pixels hit; wrote parav
 # labels are the README's.
 from paraview import servermanager  # noqa: E402
 
-for proxy, label in [(knife, "RT Schlieren"), (surface, "RT Surface Render")]:
+for proxy, label in [(knife, "RT Schlieren"), (bos, "RT BOS"), (focus, "RT Focusing Schlieren"),
+                     (surface, "RT Surface Render")]:
     assert proxy.SMProxy.GetXMLLabel() == label, proxy.SMProxy.GetXMLLabel()
     it = proxy.SMProxy.NewPropertyIterator()
     it.Begin()
@@ -104,4 +155,4 @@ assert refused, "a negative density was accepted without AllowNonphysical"
 img = arrays(RTSchlieren(Input=neg, Array=["POINTS", "density"], Size=32, Photons=1, AllowNonphysical=1))
 assert img["Intensity"].shape == (32, 32), img.keys()
 print("labels and tooltips: every property documented; AllowNonphysical=1 accepts what the default refuses")
-print("pvpython: both filters ok")
+print("pvpython: every filter ok")

@@ -3,20 +3,22 @@
 from __future__ import annotations
 
 import os
-from typing import Optional, Union
+from typing import Any, Dict, Optional, Tuple, Union
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _rtvis
 from ._checks import _array, _float, _str, _uint
 from ._volume import Mesh, Volume
+from ._watch import Optics
 
 
 def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_length: Optional[float] = None,
         f_number: float = 16.0, pixel: Optional[float] = None, distance: Optional[float] = None,
         background_distance: Optional[float] = None, dot: float = 3.0, spacing: float = 4.0,
-        samples: int = 2, seed: int = 1, background="random",
-        background_pixel: Optional[float] = None):
+        samples: int = 2, seed: int = 1, background: Union[str, os.PathLike[str], ArrayLike] = "random",
+        background_pixel: Optional[float] = None, chosen: bool = False) -> Tuple[Any, ...]:
     """Background-oriented schlieren of ``volume``, set up as ``rt bos``
     sets it up: a thin-lens camera (``focal_length`` and ``pixel`` pitch in
     metres, ``f_number``) at ``distance`` Z_A from the volume's centre on
@@ -47,6 +49,9 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
     f-number ``N·(1 + M)`` that :func:`record`'s ``airy`` wants).
     Paraxially ``|Δ| = M·Z_D·|ε|/pitch``, ``M = f/(Z_A + Z_D − f)``.
 
+    With ``chosen=True`` also the rig used, automatic choices included,
+    as an :class:`Optics` (last in the tuple): ``rtvis.bos(other,
+    **chosen)`` repeats it exactly (the same Z_D across a time series).
     Ctrl-C stops the render within a fraction of a second
     (``KeyboardInterrupt``).
 
@@ -54,7 +59,7 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
     """
     if not isinstance(volume, (Volume, Mesh)):
         raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
-    image = None
+    image: Optional[NDArray[np.float64]] = None
     name = "random"
     if isinstance(background, (str, os.PathLike)):
         name = os.fspath(background)
@@ -65,7 +70,7 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
         if (image < 0).any():
             where = tuple(int(i) for i in np.argwhere(image < 0)[0])
             raise ValueError(f"background: value at {where} is negative ({image[where]})")
-    return _rtvis._bos(
+    *out, said, rig = _rtvis._bos(
         volume._v,
         _str("axis", axis),
         _uint("size", size),
@@ -82,3 +87,11 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
         image,
         _float("background_pixel", background_pixel, optional=True),
     )
+    result: Tuple[Any, ...] = (*out, said)
+    if chosen:
+        fixed: Dict[str, Any] = dict(axis=axis, size=size, f_number=f_number, dot=dot, spacing=spacing,
+                                     samples=samples, seed=seed)
+        if image is None:
+            fixed.update(background=background, background_pixel=background_pixel)
+        result += (Optics(said, **fixed, **rig),)
+    return result

@@ -5,9 +5,10 @@ shape, NaN, out of range or an unknown option."""
 from __future__ import annotations
 
 import math
-from typing import Any, Optional, Sequence, Tuple
+from typing import Any, Literal, Optional, Sequence, Tuple, overload
 
 import numpy as np
+from numpy.typing import NDArray
 
 
 class RtvisWarning(RuntimeWarning):
@@ -16,7 +17,7 @@ class RtvisWarning(RuntimeWarning):
     makes them errors; Jupyter shows them under the cell)."""
 
 
-def _choice(name: str, value, known: Sequence[str]) -> str:
+def _choice(name: str, value: Any, known: Sequence[str]) -> str:
     if not isinstance(value, str):
         raise TypeError(f"{name}: expected one of {', '.join(known)} (a str), got {type(value).__name__}")
     if value not in known:
@@ -24,7 +25,13 @@ def _choice(name: str, value, known: Sequence[str]) -> str:
     return value
 
 
-def _number(name: str, value, *, positive: bool = False, optional: bool = False) -> Optional[float]:
+@overload
+def _number(name: str, value: Any, *, positive: bool = ..., optional: Literal[False] = ...) -> float: ...
+@overload
+def _number(name: str, value: Any, *, positive: bool = ..., optional: bool) -> Optional[float]: ...
+
+
+def _number(name: str, value: Any, *, positive: bool = False, optional: bool = False) -> Optional[float]:
     if value is None and optional:
         return None
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
@@ -37,7 +44,13 @@ def _number(name: str, value, *, positive: bool = False, optional: bool = False)
     return v
 
 
-def _float(name: str, value, *, optional: bool = False) -> Optional[float]:
+@overload
+def _float(name: str, value: Any, *, optional: Literal[False] = ...) -> float: ...
+@overload
+def _float(name: str, value: Any, *, optional: bool) -> Optional[float]: ...
+
+
+def _float(name: str, value: Any, *, optional: bool = False) -> Optional[float]:
     """``value`` as a float, its type checked only: the native half's
     set-ups check ranges (NaN and infinities included), once."""
     if value is None and optional:
@@ -47,7 +60,7 @@ def _float(name: str, value, *, optional: bool = False) -> Optional[float]:
     return float(value)
 
 
-def _str(name: str, value) -> str:
+def _str(name: str, value: Any) -> str:
     """``value`` as a str, its type checked only (the native half knows
     the names)."""
     if not isinstance(value, str):
@@ -55,13 +68,13 @@ def _str(name: str, value) -> str:
     return value
 
 
-def _uint(name: str, value, bits: int = 32) -> int:
+def _uint(name: str, value: Any, bits: int = 32) -> int:
     """``value`` as an int in the native type's domain; the native half
     checks its range."""
     return _integer(name, value, 0, 2**bits - 1)
 
 
-def _integer(name: str, value, lo: int, hi: int) -> int:
+def _integer(name: str, value: Any, lo: int, hi: int) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise TypeError(f"{name}: expected an int, got {type(value).__name__}")
     v = int(value)
@@ -70,7 +83,15 @@ def _integer(name: str, value, lo: int, hi: int) -> int:
     return v
 
 
-def _vector(name: str, value, n: int = 3) -> Tuple[float, ...]:
+@overload
+def _vector(name: str, value: Any, n: Literal[3] = ...) -> Tuple[float, float, float]: ...
+@overload
+def _vector(name: str, value: Any, n: Literal[2]) -> Tuple[float, float]: ...
+@overload
+def _vector(name: str, value: Any, n: int) -> Tuple[float, ...]: ...
+
+
+def _vector(name: str, value: Any, n: int = 3) -> Tuple[float, ...]:
     try:
         a = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -83,7 +104,7 @@ def _vector(name: str, value, n: int = 3) -> Tuple[float, ...]:
 
 
 def _array(name: str, value: Any, ndim: int, dtype: Any, *, last: Optional[int] = None, integer: bool = False,
-           nan: bool = False) -> np.ndarray:
+           nan: bool = False) -> NDArray[Any]:
     """``value`` as a C-contiguous array of ``dtype`` (copied if needed),
     its kind and shape checked; NaN allowed with ``nan``, infinities never."""
     if not isinstance(value, np.ndarray):

@@ -4,14 +4,16 @@ and ``composite_mpi`` (one image per rank of an ``mpi4py`` communicator)."""
 from __future__ import annotations
 
 import time
+from typing import Any, List, Optional, Sequence, Tuple
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _rtvis
 from ._checks import _array, _choice, _integer, _number
 
 
-def _image_pair(i, rgba, depth):
+def _image_pair(i: int, rgba: ArrayLike, depth: ArrayLike) -> Tuple[NDArray[np.float32], NDArray[np.float32]]:
     c = _array(f"rgba[{i}]", rgba, 3, np.float32, last=4)
     d = np.asarray(depth)
     if d.dtype.kind != "f":
@@ -24,7 +26,8 @@ def _image_pair(i, rgba, depth):
     return c, d
 
 
-def composite(rgba_list, depth_list):
+def composite(rgba_list: Sequence[ArrayLike], depth_list: Sequence[ArrayLike]
+              ) -> Tuple[NDArray[np.float32], NDArray[np.float32]]:
     """Depth-composites images rendered separately (sort-last): per pixel
     the fragment nearest the camera, ties to the earlier image.
 
@@ -43,19 +46,21 @@ class _Mpi4pyComm:
     messages on an ``mpi4py`` communicator (non-blocking sends, probed
     receives with a timeout)."""
 
-    def __init__(self, comm, timeout: float):
-        from mpi4py import MPI
+    def __init__(self, comm: Any, timeout: float) -> None:
+        from mpi4py import MPI  # type: ignore[import-not-found, unused-ignore]
 
         self._mpi = MPI
         self._comm = comm
         self._timeout = timeout
-        self._pending = []
+        self._pending: List[Tuple[Any, bytes]] = []
 
     def rank(self) -> int:
-        return self._comm.Get_rank()
+        rank: int = self._comm.Get_rank()
+        return rank
 
     def size(self) -> int:
-        return self._comm.Get_size()
+        size: int = self._comm.Get_size()
+        return size
 
     def send(self, to: int, tag: int, data: bytes) -> None:
         req = self._comm.Isend([data, self._mpi.BYTE], dest=to, tag=tag)
@@ -85,11 +90,11 @@ class _Mpi4pyComm:
 
 
 #: Sends left pending by a failed composite (the buffers must outlive them).
-_ABANDONED_SENDS: list = []
+_ABANDONED_SENDS: List[Tuple[Any, bytes]] = []
 
 
-def composite_mpi(rgba, depth, comm=None, schedule: str = "binary-swap", radix: int = 4,
-                  timeout: float = 60.0):
+def composite_mpi(rgba: ArrayLike, depth: ArrayLike, comm: Any = None, schedule: str = "binary-swap",
+                  radix: int = 4, timeout: float = 60.0) -> Optional[Tuple[NDArray[np.float32], NDArray[np.float32]]]:
     """Depth-composites this rank's image with every other rank's of the
     ``mpi4py`` communicator ``comm`` (default ``MPI.COMM_WORLD``), with
     rt-composite's ``schedule`` (``binary-swap``, ``radix-k`` with
@@ -100,7 +105,7 @@ def composite_mpi(rgba, depth, comm=None, schedule: str = "binary-swap", radix: 
     makes every rank raise ``ValueError`` instead of hanging.
     """
     try:
-        from mpi4py import MPI
+        from mpi4py import MPI  # type: ignore[import-not-found, unused-ignore]
     except ImportError as e:
         raise ImportError("composite_mpi needs mpi4py (pip install mpi4py, or Debian's python3-mpi4py)") from e
     if comm is None:

@@ -3,18 +3,22 @@ sets it up."""
 
 from __future__ import annotations
 
-from typing import Optional, Union
+from typing import Any, Optional, Tuple, Union
+
+import numpy as np
+from numpy.typing import NDArray
 
 from . import _rtvis
 from ._checks import _float, _str, _uint
 from ._volume import Mesh, Volume
+from ._watch import Optics
 
 
 def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_length: Optional[float] = None,
              aperture: Optional[float] = None, pixel: Optional[float] = None, distance: Optional[float] = None,
              focus: float = 0.0, source_distance: Optional[float] = None, pitch: Optional[float] = None,
              duty: float = 0.5, angle: float = 0.0, offset: float = 0.25, bands: Optional[int] = None,
-             samples: int = 6, seed: int = 1):
+             samples: int = 6, seed: int = 1, chosen: bool = False) -> Tuple[Any, ...]:
     """Focusing schlieren of ``volume`` (a lens-and-grid system, Weinstein
     1993), set up as ``rt focusing`` sets it up: the same defaults, the
     same automatic choices, the same image bit for bit. A source grid of
@@ -75,15 +79,17 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
     (offset·pitch)`` for a deflection ``ε`` across the bands in the focus
     plane at ``Z_F``, the source grid at ``Z_S``.
 
-    Ctrl-C stops the render within a fraction of a second
-    (``KeyboardInterrupt``).
+    With ``chosen=True`` also the rig used, automatic choices included
+    (the pitch among them), as an :class:`Optics` (last in the tuple):
+    ``rtvis.focusing(other, **chosen)`` repeats it exactly. Ctrl-C stops
+    the render within a fraction of a second (``KeyboardInterrupt``).
 
     Example: ``ref, flow, rel, info = rtvis.focusing(vol, focus=0.01,
     aperture=0.3)``.
     """
     if not isinstance(volume, (Volume, Mesh)):
         raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
-    return _rtvis._focusing(
+    *out, said, rig = _rtvis._focusing(
         volume._v,
         _str("axis", axis),
         _uint("size", size),
@@ -101,3 +107,9 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
         _uint("samples", samples),
         _uint("seed", seed, 64),
     )
+    result: Tuple[Any, ...] = (*out, said)
+    if chosen:
+        fixed = dict(axis=axis, size=size, focus=focus, duty=duty, angle=angle, offset=offset, bands=bands,
+                     samples=samples, seed=seed)
+        result += (Optics(said, **fixed, **rig),)
+    return result

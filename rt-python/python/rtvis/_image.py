@@ -3,15 +3,19 @@
 
 from __future__ import annotations
 
+import os
 import struct
+import sys
 import zlib
+from typing import Any, Union
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ._checks import _array, _number, _vector
 
 
-def to_srgb8(rgba, background=(1.0, 1.0, 1.0)) -> np.ndarray:
+def to_srgb8(rgba: ArrayLike, background: ArrayLike = (1.0, 1.0, 1.0)) -> NDArray[np.uint8]:
     """Premultiplied linear RGBA (h, w, 4) over a linear ``background``
     colour, as 8-bit sRGB (h, w, 3) ``uint8``: ready for any image
     writer."""
@@ -20,13 +24,13 @@ def to_srgb8(rgba, background=(1.0, 1.0, 1.0)) -> np.ndarray:
     return _srgb8(c[..., :3] + (1.0 - c[..., 3:4]) * bg)
 
 
-def _srgb8(linear: np.ndarray) -> np.ndarray:
+def _srgb8(linear: NDArray[Any]) -> NDArray[np.uint8]:
     lin = np.clip(linear, 0.0, 1.0)
-    srgb = np.where(lin <= 0.0031308, 12.92 * lin, 1.055 * np.power(lin, 1 / 2.4) - 0.055)
+    srgb: NDArray[Any] = np.where(lin <= 0.0031308, 12.92 * lin, 1.055 * np.power(lin, 1 / 2.4) - 0.055)
     return np.round(srgb * 255.0).astype(np.uint8)
 
 
-def to_gray8(image, white: float = 2.0) -> np.ndarray:
+def to_gray8(image: ArrayLike, white: float = 2.0) -> NDArray[np.uint8]:
     """An optics image (intensity, 1 = background) as 8-bit sRGB grey
     ``uint8`` (h, w): ``white`` maps to 255, 0 to 0, linearly in light
     (so the background of a normalised image, 1 of 2, is mid grey)."""
@@ -34,7 +38,7 @@ def to_gray8(image, white: float = 2.0) -> np.ndarray:
     return _srgb8(a / _number("white", white, positive=True))
 
 
-def save_png(path, image) -> None:
+def save_png(path: Union[str, os.PathLike[str]], image: ArrayLike) -> None:
     """Writes an 8-bit image, ``uint8`` (h, w) grey, (h, w, 3) RGB or
     (h, w, 4) RGBA, as a PNG (no other package needed). Convert first:
     :func:`to_srgb8` for surfaces, :func:`to_gray8` for optics images,
@@ -44,9 +48,6 @@ def save_png(path, image) -> None:
     on stderr), a path that is a folder raises ``IsADirectoryError``
     before anything is encoded, and the file appears whole or not at all
     (written beside it, then moved into place)."""
-    import os
-    import sys
-
     path = os.fspath(path)
     if os.path.isdir(path):
         raise IsADirectoryError(f"{path}: is a folder; give a file name (e.g. {os.path.join(path, 'image.png')})")

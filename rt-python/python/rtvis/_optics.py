@@ -4,9 +4,10 @@ the focal plane), and ``record`` (a camera sensor's counts)."""
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union, cast
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _rtvis
 from ._checks import RtvisWarning, _array, _float, _integer, _number, _str, _uint
@@ -24,13 +25,14 @@ def _bench(volume: Union[Volume, Mesh], cutoff: str, *, angle: float = 0.0, f: f
            film_distance: Optional[float] = None, axis: str = "z", size: int = 512, photons: int = 16,
            seed: int = 1, estimator: str = "sheet",
            output: Tuple[bool, bool, bool, bool, bool] = (True, True, False, True, True),
-           progress: Union[None, bool, ProgressCallback] = None) -> Tuple[Any, ...]:
+           progress: Union[None, bool, ProgressCallback] = None
+           ) -> Tuple[NDArray[Any], Optional[NDArray[np.float32]], Optional[NDArray[np.float64]], Dict[str, Any], str]:
     """The bench's film: ``(image, deflection, phase, chosen, description)``;
     ``output = (rgb, float64, relative, deflection, phase)`` says what to
     make (the default: the film's own RGB in float64, everything)."""
     if not isinstance(volume, (Volume, Mesh)):
         raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
-    *out, warning = _rtvis._optics(
+    image, deflection, phase, chosen, said, warning = _rtvis._optics(
         volume._v,
         cutoff,
         _float("angle", angle),
@@ -46,24 +48,24 @@ def _bench(volume: Union[Volume, Mesh], cutoff: str, *, angle: float = 0.0, f: f
         _uint("photons", photons),
         _uint("seed", seed, 64),
         _str("estimator", estimator),
-        tuple(bool(o) for o in output),
+        cast(Tuple[bool, bool, bool, bool, bool], tuple(bool(o) for o in output)),
         _progress(progress, _NAMES.get(cutoff, "rtvis.schlieren")),
     )
     if warning is not None:
         import warnings
 
         warnings.warn(warning, RtvisWarning, stacklevel=4)
-    return tuple(out)
+    return image, deflection, phase, chosen, said
 
 
-def _dtype(dtype: Any) -> np.dtype:
-    d = np.dtype(dtype)
+def _dtype(dtype: Any) -> np.dtype[Any]:
+    d: np.dtype[Any] = np.dtype(dtype)
     if d not in (np.dtype(np.float32), np.dtype(np.float64)):
         raise ValueError(f"dtype: expected float32 or float64, got {d}")
     return d
 
 
-def _grey(image: np.ndarray, background: Sequence[float], dtype: Any) -> np.ndarray:
+def _grey(image: NDArray[Any], background: Sequence[float], dtype: Any) -> NDArray[Any]:
     """Channel 0 (in f64) divided by the background's level (when it is
     not 0), as `dtype`."""
     b = float(background[0])
@@ -275,9 +277,9 @@ def color_schlieren(
                    size=size, photons=photons, seed=seed)
 
 
-def record(image, exposure: float = 10_000.0, full_well: float = 20_000.0, bits: int = 16,
+def record(image: ArrayLike, exposure: float = 10_000.0, full_well: float = 20_000.0, bits: int = 16,
            shot_noise: bool = False, read_noise: float = 0.0, seed: int = 0,
-           airy: Optional[Tuple[float, float, float]] = None) -> np.ndarray:
+           airy: Optional[Tuple[float, float, float]] = None) -> NDArray[np.uint16]:
     """Records an optics image as a camera sensor would: a pixel of
     intensity ``I`` (1 = background) collects ``exposure·I`` electrons on
     average; with ``shot_noise`` the count is Poisson, plus Gaussian

@@ -4,13 +4,21 @@ glyphs, tubes) rendered into premultiplied RGBA and depth."""
 from __future__ import annotations
 
 import math
-from typing import Any, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _rtvis
 from ._checks import _array, _choice, _integer, _number, _vector
+from ._volume import _Bounds, _xyz
 from ._watch import ProgressCallback, _progress
+
+#: A material: ``"matte"``, ``"glossy"`` or a dict of its fields.
+_Material = Union[str, Dict[str, float]]
+#: A light: ``("ambient", rgb)``, ``("directional", toward_light, rgb)`` or
+#: ``("point", position, rgb)``.
+_Light = Union[Tuple[str, ArrayLike], Tuple[str, ArrayLike, ArrayLike]]
 
 
 class Camera:
@@ -19,8 +27,8 @@ class Camera:
     ``ortho_height`` the projection is orthographic, that many scene
     units tall."""
 
-    def __init__(self, eye, target, up=(0.0, 1.0, 0.0), fov: float = 30.0,
-                 ortho_height: Optional[float] = None):
+    def __init__(self, eye: ArrayLike, target: ArrayLike, up: ArrayLike = (0.0, 1.0, 0.0), fov: float = 30.0,
+                 ortho_height: Optional[float] = None) -> None:
         self.eye = _vector("eye", eye)
         self.target = _vector("target", target)
         self.up = _vector("up", up)
@@ -30,8 +38,8 @@ class Camera:
         self.ortho_height = _number("ortho_height", ortho_height, positive=True, optional=True)
 
     @classmethod
-    def fit(cls, bounds, direction=(0.0, 0.0, 1.0), up=(0.0, 1.0, 0.0), fov: float = 30.0,
-            aspect: float = 1.0) -> "Camera":
+    def fit(cls, bounds: Sequence[ArrayLike], direction: ArrayLike = (0.0, 0.0, 1.0),
+            up: ArrayLike = (0.0, 1.0, 0.0), fov: float = 30.0, aspect: float = 1.0) -> "Camera":
         """A camera looking at the centre of ``bounds`` (``(lo, hi)``
         corners) from ``direction`` (toward the eye), far enough back that
         the bounding sphere fills the view (``aspect`` = width / height)."""
@@ -58,10 +66,11 @@ _MATERIALS = {
 _COLORMAPS = ("cool_to_warm", "viridis", "grayscale")
 
 #: The default lights: dim ambient light and a directional key light.
-DEFAULT_LIGHTS = [("ambient", (0.25, 0.25, 0.25)), ("directional", (-0.5, 1.0, 0.35), (0.8, 0.8, 0.8))]
+DEFAULT_LIGHTS: List[_Light] = [("ambient", (0.25, 0.25, 0.25)),
+                                ("directional", (-0.5, 1.0, 0.35), (0.8, 0.8, 0.8))]
 
 
-def _material(m) -> Tuple[float, ...]:
+def _material(m: _Material) -> Tuple[float, ...]:
     if isinstance(m, str):
         return _MATERIALS[_choice("material", m, tuple(_MATERIALS))]
     if isinstance(m, dict):
@@ -75,7 +84,10 @@ def _material(m) -> Tuple[float, ...]:
     raise TypeError(f"material: expected 'matte', 'glossy' or a dict, got {type(m).__name__}")
 
 
-def _paint_args(n: int, scalars, color, colormap, range):
+def _paint_args(n: int, scalars: Optional[ArrayLike], color: Optional[ArrayLike], colormap: str,
+                range: Optional[ArrayLike]
+                ) -> Tuple[Optional[NDArray[np.float32]], Optional[Tuple[float, float, float]], str,
+                           Optional[Tuple[float, float]]]:
     s = None
     if scalars is not None:
         s = np.ascontiguousarray(_array_allow_nan("scalars", scalars, n), dtype=np.float32)
@@ -84,7 +96,7 @@ def _paint_args(n: int, scalars, color, colormap, range):
     return s, c, _choice("colormap", colormap, _COLORMAPS), r
 
 
-def _array_allow_nan(name: str, value, n: int) -> np.ndarray:
+def _array_allow_nan(name: str, value: ArrayLike, n: int) -> NDArray[Any]:
     """One number per item (NaN allowed: it maps to the colour map's NaN
     colour)."""
     a = np.asarray(value)
@@ -107,11 +119,12 @@ class Scene:
     ``diffuse``, ``specular``, ``shininess``, ``opacity``, ``mirror``.
     """
 
-    def __init__(self):
+    def __init__(self) -> None:
         self._s = _rtvis._Scene()
 
-    def add_mesh(self, points, triangles, scalars=None, color=None, colormap: str = "cool_to_warm",
-                 range=None, material="glossy", smooth: bool = True, normals=None) -> "Scene":
+    def add_mesh(self, points: ArrayLike, triangles: ArrayLike, scalars: Optional[ArrayLike] = None,
+                 color: Optional[ArrayLike] = None, colormap: str = "cool_to_warm", range: Optional[ArrayLike] = None,
+                 material: _Material = "glossy", smooth: bool = True, normals: Optional[ArrayLike] = None) -> "Scene":
         """Adds a triangle mesh: ``points`` (n, 3), ``triangles`` (m, 3)
         integer indices into the points, ``scalars`` (n,) per point.
         Shading normals: ``normals`` (n, 3) per point if given (e.g. a
@@ -128,8 +141,9 @@ class Scene:
         self._s.add_mesh(p, t, s, c, cm, r, _material(material), bool(smooth), nrm)
         return self
 
-    def add_spheres(self, centers, radii, scalars=None, color=None, colormap: str = "cool_to_warm",
-                    range=None, material="glossy") -> "Scene":
+    def add_spheres(self, centers: ArrayLike, radii: ArrayLike, scalars: Optional[ArrayLike] = None,
+                    color: Optional[ArrayLike] = None, colormap: str = "cool_to_warm",
+                    range: Optional[ArrayLike] = None, material: _Material = "glossy") -> "Scene":
         """Adds sphere glyphs: ``centers`` (n, 3), ``radii`` one number or
         (n,), ``scalars`` (n,)."""
         p = _array("centers", centers, 2, np.float32, last=3)
@@ -139,16 +153,18 @@ class Scene:
         self._s.add_spheres(p, r, s, c, cm, rg, _material(material))
         return self
 
-    def add_tubes(self, polyline, radius: float, scalars=None, color=None, colormap: str = "cool_to_warm",
-                  range=None, material="glossy") -> "Scene":
+    def add_tubes(self, polyline: ArrayLike, radius: float, scalars: Optional[ArrayLike] = None,
+                  color: Optional[ArrayLike] = None, colormap: str = "cool_to_warm",
+                  range: Optional[ArrayLike] = None, material: _Material = "glossy") -> "Scene":
         """Adds a tube of ``radius`` along ``polyline`` ((n, 3) points,
         n ≥ 2), or one tube per polyline given a list of them (then
         ``scalars`` is a list too); ``scalars`` (n,) per point."""
         if isinstance(polyline, (list, tuple)) and polyline and np.ndim(polyline[0]) == 2:
-            if scalars is not None and len(scalars) != len(polyline):
-                raise ValueError(f"scalars: expected one array per polyline ({len(polyline)}), got {len(scalars)}")
+            each: Any = scalars  # a list too, one array per polyline
+            if each is not None and len(each) != len(polyline):
+                raise ValueError(f"scalars: expected one array per polyline ({len(polyline)}), got {len(each)}")
             for i, line in enumerate(polyline):
-                self.add_tubes(line, radius, None if scalars is None else scalars[i], color, colormap, range, material)
+                self.add_tubes(line, radius, None if each is None else each[i], color, colormap, range, material)
             return self
         p = _array("polyline", polyline, 2, np.float32, last=3)
         s, c, cm, r = _paint_args(len(p), scalars, color, colormap, range)
@@ -158,16 +174,17 @@ class Scene:
     def __len__(self) -> int:
         return len(self._s)
 
-    def bounds(self):
+    def bounds(self) -> Optional[_Bounds]:
         """``((xmin, ymin, zmin), (xmax, ymax, zmax))`` over every object
         (spheres and tubes with their radii), or ``None`` when empty."""
         b = self._s.bounds()
-        return None if b is None else (tuple(b[0]), tuple(b[1]))
+        return None if b is None else (_xyz(b[0]), _xyz(b[1]))
 
     def render(self, camera: Optional[Camera] = None, size: Union[int, Tuple[int, int]] = 512,
                ao: int = 0, ao_distance: Optional[float] = None, shadows: bool = True,
-               passes: int = 1, seed: int = 0, lights: Optional[Sequence[Any]] = None,
-               progress: Union[None, bool, ProgressCallback] = None) -> Tuple[np.ndarray, np.ndarray]:
+               passes: int = 1, seed: int = 0, lights: Optional[Sequence[_Light]] = None,
+               progress: Union[None, bool, ProgressCallback] = None
+               ) -> Tuple[NDArray[np.float32], NDArray[np.float32]]:
         """Ray traces the scene.
 
         Parameters
@@ -209,7 +226,8 @@ class Scene:
         background). Accumulators too large for memory raise
         ``MemoryError``.
         """
-        w, h = (size, size) if np.ndim(size) == 0 else tuple(size)
+        wh: Any = size  # np.ndim does not narrow the Union
+        w, h = (wh, wh) if np.ndim(wh) == 0 else tuple(wh)
         w = _integer("size[0]", w, 1, 16384)
         h = _integer("size[1]", h, 1, 16384)
         b = self.bounds()

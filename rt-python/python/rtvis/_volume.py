@@ -4,9 +4,12 @@
 
 from __future__ import annotations
 
-from typing import Any, Optional, Tuple
+import importlib
+import os
+from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _rtvis
 from ._checks import _array, _choice, _number, _vector
@@ -22,14 +25,22 @@ _NANS = ("error", "ambient")
 # The image's (u, v) world axes for each beam axis: u to the right, v up.
 _IMAGE_AXES = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}
 
+#: ``((xmin, ymin, zmin), (xmax, ymax, zmax))``.
+_Bounds = Tuple[Tuple[float, float, float], Tuple[float, float, float]]
 
-def _extent(bounds: Tuple[Tuple[float, ...], Tuple[float, ...]], axis: str) -> Tuple[float, float, float, float]:
+
+def _xyz(v: Sequence[float]) -> Tuple[float, float, float]:
+    """A native ``[x, y, z]`` list as a tuple."""
+    return (v[0], v[1], v[2])
+
+
+def _extent(bounds: _Bounds, axis: str) -> Tuple[float, float, float, float]:
     u, v = _IMAGE_AXES[_choice("axis", axis, tuple(_IMAGE_AXES))]
     lo, hi = bounds
     return (lo[u], hi[u], lo[v], hi[v])
 
 
-def _far_field(values: np.ndarray) -> float:
+def _far_field(values: NDArray[Any]) -> float:
     """The median of the finite samples on the volume's six faces: the
     undisturbed medium around a flow."""
     faces = [values[0], values[-1], values[:, 0], values[:, -1], values[:, :, 0], values[:, :, -1]]
@@ -82,9 +93,9 @@ class Volume:
 
     def __init__(
         self,
-        values,
-        spacing=(1.0, 1.0, 1.0),
-        origin=(0.0, 0.0, 0.0),
+        values: ArrayLike,
+        spacing: ArrayLike = (1.0, 1.0, 1.0),
+        origin: ArrayLike = (0.0, 0.0, 0.0),
         quantity: str = "density",
         k: float = GLADSTONE_DALE_AIR,
         interpolation: str = "cubic",
@@ -125,10 +136,10 @@ class Volume:
         for method in ("GetDimensions", "GetSpacing", "GetOrigin", "GetPointData", "GetCellData"):
             if not callable(getattr(image, method, None)):
                 raise TypeError(f"image: expected a vtkImageData (or pyvista.ImageData), got {type(image).__name__}")
-        try:
-            from vtkmodules.util.numpy_support import vtk_to_numpy
+        try:  # VTK's own modules, untyped: Any
+            numpy_support: Any = importlib.import_module("vtkmodules.util.numpy_support")
         except ImportError:  # VTK before 8.2
-            from vtk.util.numpy_support import vtk_to_numpy  # type: ignore[no-redef]
+            numpy_support = importlib.import_module("vtk.util.numpy_support")
         matrix = getattr(image, "GetDirectionMatrix", None)
         if matrix is not None and not matrix().IsIdentity():
             raise ValueError("image: its direction matrix is not the identity (a rotated image is not supported)")
@@ -159,7 +170,7 @@ class Volume:
         if where == "cell":
             dims = tuple(max(d - 1, 1) for d in dims)
             origin = tuple(o + 0.5 * h for o, h in zip(origin, spacing))
-        values = vtk_to_numpy(vtk_array).reshape(dims[::-1])
+        values = numpy_support.vtk_to_numpy(vtk_array).reshape(dims[::-1])
         return cls(values, spacing=spacing, origin=origin, **options)
 
     @classmethod
@@ -171,7 +182,7 @@ class Volume:
         return cls.from_vtk(grid, array, **options)
 
     @classmethod
-    def _wrap(cls, native) -> "Volume":
+    def _wrap(cls, native: _rtvis._Volume) -> "Volume":
         v = cls.__new__(cls)
         v._v = native
         return v
@@ -179,26 +190,26 @@ class Volume:
     @property
     def shape(self) -> Tuple[int, int, int]:
         """Samples per axis, ``(nz, ny, nx)``."""
-        return tuple(self._v.shape)
+        return self._v.shape
 
     @property
     def spacing(self) -> Tuple[float, float, float]:
         """Sample spacing ``(dx, dy, dz)``."""
-        return tuple(self._v.spacing)
+        return _xyz(self._v.spacing)
 
     @property
     def origin(self) -> Tuple[float, float, float]:
         """Centre of sample ``[0, 0, 0]``, ``(x, y, z)``."""
-        return tuple(self._v.origin)
+        return _xyz(self._v.origin)
 
     @property
-    def bounds(self):
+    def bounds(self) -> _Bounds:
         """``((xmin, ymin, zmin), (xmax, ymax, zmax))``: the box the
         samples span."""
         lo, hi = self._v.bounds
-        return tuple(lo), tuple(hi)
+        return _xyz(lo), _xyz(hi)
 
-    def index(self) -> np.ndarray:
+    def index(self) -> NDArray[np.float32]:
         """The refractive index samples, float32 ``[z, y, x]``."""
         return self._v.index()
 
@@ -216,7 +227,7 @@ class Volume:
 
 
 def read_volume(
-    path,
+    path: Union[str, os.PathLike[str]],
     quantity: str = "density",
     k: float = GLADSTONE_DALE_AIR,
     interpolation: str = "cubic",
@@ -229,8 +240,6 @@ def read_volume(
     :class:`Volume`. Raises ``OSError`` if the file cannot be read and
     ``ValueError`` if it is malformed or holds no usable grid.
     """
-    import os
-
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path: expected a str or path, got {type(path).__name__}")
     native = _rtvis._read_volume(
@@ -280,14 +289,14 @@ class Mesh:
     index outside the mesh is that of its first point.
     """
 
-    def __init__(self, points, cells, values, quantity: str = "density",
+    def __init__(self, points: ArrayLike, cells: Dict[str, Any], values: ArrayLike, quantity: str = "density",
                  k: float = GLADSTONE_DALE_AIR, trace: str = "smooth",
-                 allow_nonphysical: bool = False):
+                 allow_nonphysical: bool = False) -> None:
         pts = _array("points", points, 2, np.float64, last=3)
         vals = _array("values", values, 1, np.float64)
         if not isinstance(cells, dict):
             raise TypeError(f"cells: expected a dict of kind → array, got {type(cells).__name__}")
-        by_kind = {}
+        by_kind: Dict[str, NDArray[np.int64]] = {}
         for kind, arr in cells.items():
             if kind in _SURFACE_KINDS or np.asarray(arr).size == 0:
                 continue  # no volume (meshio lists boundary patches too)
@@ -305,22 +314,22 @@ class Mesh:
         )
 
     @classmethod
-    def _wrap(cls, native) -> "Mesh":
+    def _wrap(cls, native: _rtvis._Volume) -> "Mesh":
         m = cls.__new__(cls)
         m._v = native
         return m
 
     @property
-    def bounds(self):
+    def bounds(self) -> _Bounds:
         """``((xmin, ymin, zmin), (xmax, ymax, zmax))``: the box around the
         points."""
         lo, hi = self._v.bounds
-        return tuple(lo), tuple(hi)
+        return _xyz(lo), _xyz(hi)
 
     @property
     def counts(self) -> Tuple[int, int, int, int]:
         """``(points, cells, tetrahedra, boundary faces)``."""
-        return tuple(self._v.mesh_counts)
+        return self._v.mesh_counts
 
     def extent(self, axis: str = "z") -> Tuple[float, float, float, float]:
         """``(left, right, bottom, top)`` of the images along ``axis``, as
@@ -333,7 +342,7 @@ class Mesh:
 
 
 def read_mesh(
-    path,
+    path: Union[str, os.PathLike[str]],
     array: Optional[str] = None,
     quantity: str = "density",
     k: float = GLADSTONE_DALE_AIR,
@@ -349,8 +358,6 @@ def read_mesh(
     points); the others as for :class:`Mesh`. Raises ``OSError`` if the
     file cannot be read and ``ValueError`` if it is malformed.
     """
-    import os
-
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path: expected a str or path, got {type(path).__name__}")
     if array is not None and not isinstance(array, str):
