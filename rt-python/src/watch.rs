@@ -49,7 +49,7 @@ impl Watch {
 
 /// Runs `work` on its own thread with the GIL released while this thread
 /// watches it (module doc): `progress(done, total)` is called on this
-/// thread whenever the count moved, and once at the end.
+/// thread whenever the count moved, the final count included.
 ///
 /// # Errors
 /// The `KeyboardInterrupt` (or other signal handler's exception) or the
@@ -71,13 +71,15 @@ pub(crate) fn watched<T: Send>(
             });
             let mut failed: Option<PyErr> = None;
             let mut shown = (0, 0);
-            let mut look = |final_call: bool| {
+            // Checks for signals and reports the count if it moved (so
+            // the callback sees each count once, the last one included).
+            let mut look = || {
                 let now = watch.seen();
                 let r = Python::attach(|py| -> PyResult<()> {
                     py.check_signals()?;
                     if let Some(cb) = &progress
                         && now.1 > 0
-                        && (now != shown || final_call)
+                        && now != shown
                     {
                         cb.bind(py).call1(now)?;
                     }
@@ -89,7 +91,7 @@ pub(crate) fn watched<T: Send>(
             while !worker.is_finished() {
                 std::thread::park_timeout(POLL);
                 if failed.is_none()
-                    && let Err(e) = look(false)
+                    && let Err(e) = look()
                 {
                     watch.stop.store(true, Ordering::Relaxed);
                     failed = Some(e);
@@ -98,7 +100,7 @@ pub(crate) fn watched<T: Send>(
             let outcome = worker.join();
             if failed.is_none()
                 && outcome.is_ok()
-                && let Err(e) = look(true)
+                && let Err(e) = look()
             {
                 failed = Some(e);
             }

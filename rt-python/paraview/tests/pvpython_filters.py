@@ -88,7 +88,7 @@ focus = RTFocusingSchlieren(Input=strong, Array=["POINTS", "density"], Size=48, 
 got = arrays(focus)
 assert np.array_equal(got["Relative"], rtvis.focusing(vol, size=48, samples=3)[2])
 assert got["Relative"].std() > 1e-3
-rtvis.save_png(os.path.join(out_dir, "paraview-bos.png"), rtvis.to_gray8(got["Relative"], white=2.0))
+rtvis.save_png(os.path.join(out_dir, "paraview-focusing.png"), rtvis.to_gray8(got["Relative"], white=2.0))
 print("RT BOS and RT Focusing Schlieren: equal to rtvis.bos and rtvis.focusing")
 
 # A time series with the exposure locked: the second step keeps the
