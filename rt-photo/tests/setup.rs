@@ -185,5 +185,15 @@ fn renders_stop_when_told_and_only_then() {
             .unwrap();
     let got = foc.render_until(&m, 1, &stop_after(100));
     assert!(matches!(got, Err(SetupError::Stopped)), "focusing: {:?}", got.map(|_| ()));
-    assert!(foc.render_until(&m, 1, &|| false).is_ok());
+    // Asked once a ray: width × height × k² (progress counts on it).
+    let asked = AtomicU64::new(0);
+    let count = || asked.fetch_add(1, Ordering::Relaxed) == u64::MAX;
+    let c = foc.system.camera;
+    foc.render_until(&m, 1, &count).unwrap();
+    let k = u64::from(foc.system.aperture_samples);
+    assert_eq!(asked.swap(0, Ordering::Relaxed), (c.width * c.height) as u64 * k * k);
+    let c = bos.bos.camera;
+    bos.render_until(&m, 1, &count).unwrap();
+    let k = u64::from(bos.bos.aperture_samples);
+    assert_eq!(asked.into_inner(), (c.width * c.height) as u64 * k * k);
 }

@@ -233,7 +233,8 @@ class _VolumeInput:
                                allow_nonphysical=bool(self._nonphysical))
         except ValueError as e:
             # rtvis names its keywords; here they are properties.
-            raise ValueError(f"{label}: {e} (here: check Quantity, or tick Allow Nonphysical)") from e
+            what = str(e).split("; check quantity=")[0]
+            raise ValueError(f"{label}: {what}; check Quantity, or tick Allow Nonphysical") from e
         return vol, image
 
     def _progress(self, done, total):
@@ -242,17 +243,14 @@ class _VolumeInput:
         if self.GetAbortExecute():
             raise _Aborted()
 
-    def _render(self, render, vol, options, progress=True):
+    def _render(self, render, vol, options):
         """``render(vol, **options)`` with the locked optics if any (else
         choosing them, and locking them when asked), reporting progress
-        to ParaView and honouring its abort (where the render counts its
-        work: the schlieren family); ``None`` if aborted."""
+        to ParaView and honouring its abort; ``None`` if aborted."""
         if self._lock and self._locked is not None:
             options = {**options, **self._locked}
-        if progress:
-            options = {**options, "progress": self._progress}
         try:
-            *out, chosen = render(vol, chosen=True, **options)
+            *out, chosen = render(vol, chosen=True, progress=self._progress, **options)
         except _Aborted:
             return None
         if self._lock and self._locked is None:
@@ -452,7 +450,7 @@ class RTBOS(_VolumeInput, VTKPythonAlgorithmBase):
                        distance=self._distance or None, background_distance=self._zd or None, dot=self._dot,
                        spacing=self._spacing, samples=self._samples,
                        background=["random", "grid"][self._background])
-        out = self._render(rtvis.bos, vol, options, progress=False)
+        out = self._render(rtvis.bos, vol, options)
         if out is None:
             return 1
         reference, flow, disp, _ = out
@@ -534,7 +532,7 @@ class RTFocusingSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
                        aperture=self._aperture or None, focal_length=self._focal or None,
                        source_distance=self._source or None, pitch=self._pitch or None, duty=self._duty,
                        angle=self._angle, offset=self._offset, samples=self._samples)
-        out = self._render(rtvis.focusing, vol, options, progress=False)
+        out = self._render(rtvis.focusing, vol, options)
         if out is None:
             return 1
         reference, flow, relative, _ = out

@@ -319,7 +319,14 @@ pub(crate) fn bos<'py>(
     let v = &volume.inner;
     let (setup, images) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
         let setup = BosSetup::choose(v, &options)?;
-        let images = setup.render_until(v, seed, &|| w.stopped())?;
+        // One `stop` question per ray: k² rays a pixel.
+        let c = &setup.bos.camera;
+        let rays = (c.width * c.height) as u64 * u64::from(setup.bos.aperture_samples).pow(2);
+        let images = setup.render_until(v, seed, &|| {
+            w.count_one(rays);
+            w.stopped()
+        })?;
+        w.progress(rays, rays);
         Ok((setup, images))
     })?
     .map_err(setup_error)?;
@@ -402,7 +409,14 @@ pub(crate) fn focusing<'py>(
     let v = &volume.inner;
     let (setup, images) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
         let setup = FocusingSetup::choose(v, &options)?;
-        let images = setup.render_until(v, seed, &|| w.stopped())?;
+        // One `stop` question per ray: k stripes of k rays a pixel.
+        let c = &setup.system.camera;
+        let rays = (c.width * c.height) as u64 * u64::from(setup.system.aperture_samples).pow(2);
+        let images = setup.render_until(v, seed, &|| {
+            w.count_one(rays);
+            w.stopped()
+        })?;
+        w.progress(rays, rays);
         Ok((setup, images))
     })?
     .map_err(setup_error)?;

@@ -42,6 +42,30 @@ impl Watch {
         self.done.store(done, Ordering::Relaxed);
     }
 
+    /// Counts one unit of `total` (a ray, from the workers): batched per
+    /// thread, so the shared counter is touched once per 256 rays. Call
+    /// [`Watch::progress`] with the total at the end: up to 255 a thread
+    /// are still in the batches.
+    pub(crate) fn count_one(&self, total: u64) {
+        thread_local! {
+            static PENDING: core::cell::Cell<u64> = const { core::cell::Cell::new(0) };
+        }
+        PENDING.with(|pending| {
+            let n = pending.get() + 1;
+            if n < 256 {
+                pending.set(n);
+                return;
+            }
+            pending.set(0);
+            self.total.store(total, Ordering::Relaxed);
+            let done = self.done.fetch_add(n, Ordering::Relaxed) + n;
+            // A batch left over from an earlier render cannot pass the end.
+            if done > total {
+                self.done.store(total, Ordering::Relaxed);
+            }
+        });
+    }
+
     fn seen(&self) -> (u64, u64) {
         (self.done.load(Ordering::Relaxed), self.total.load(Ordering::Relaxed))
     }

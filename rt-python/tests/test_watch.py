@@ -85,6 +85,12 @@ def test_progress_is_reported_on_the_calling_thread_up_to_the_total(capsys):
     assert tiles[-1][0] == tiles[-1][1] and tiles[-1][1] % 3 == 0
     with pytest.raises(TypeError, match="progress"):
         rtvis.schlieren(vol, size=16, progress="yes")
+    # BOS and focusing count rays: width × height × samples².
+    for render, kw, k in ((rtvis.bos, dict(samples=3), 3), (rtvis.focusing, dict(samples=2), 2)):
+        rays = []
+        image = render(vol, size=40, progress=lambda d, t: rays.append((d, t)), **kw)[0]
+        assert rays[-1] == (image.size * k * k,) * 2, (render.__name__, rays[-1])
+        assert all(a[0] < b[0] for a, b in zip(rays, rays[1:]))
 
 
 def test_an_exception_in_the_progress_callback_stops_the_render():

@@ -11,14 +11,15 @@ from numpy.typing import ArrayLike, NDArray
 from . import _rtvis
 from ._checks import _array, _float, _str, _uint
 from ._volume import Mesh, Volume
-from ._watch import Optics
+from ._watch import Optics, ProgressCallback, _progress
 
 
 def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_length: Optional[float] = None,
         f_number: float = 16.0, pixel: Optional[float] = None, distance: Optional[float] = None,
         background_distance: Optional[float] = None, dot: float = 3.0, spacing: float = 4.0,
         samples: int = 2, seed: int = 1, background: Union[str, os.PathLike[str], ArrayLike] = "random",
-        background_pixel: Optional[float] = None, chosen: bool = False) -> Tuple[Any, ...]:
+        background_pixel: Optional[float] = None, chosen: bool = False,
+        progress: Union[None, bool, ProgressCallback] = None) -> Tuple[Any, ...]:
     """Background-oriented schlieren of ``volume``, set up as ``rt bos``
     sets it up: a thin-lens camera (``focal_length`` and ``pixel`` pitch in
     metres, ``f_number``) at ``distance`` Z_A from the volume's centre on
@@ -52,6 +53,8 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
     With ``chosen=True`` also the rig used, automatic choices included,
     as an :class:`Optics` (last in the tuple): ``rtvis.bos(other,
     **chosen)`` repeats it exactly (the same Z_D across a time series).
+    ``progress``: ``True`` draws a progress bar on stderr, a callable is
+    called as ``progress(done, total)`` (rays) on the calling thread.
     Ctrl-C stops the render within a fraction of a second
     (``KeyboardInterrupt``).
 
@@ -86,6 +89,7 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
         name,
         image,
         _float("background_pixel", background_pixel, optional=True),
+        _progress(progress, "rtvis.bos"),
     )
     result: Tuple[Any, ...] = (*out, said)
     if chosen:

@@ -11,14 +11,15 @@ from numpy.typing import NDArray
 from . import _rtvis
 from ._checks import _float, _str, _uint
 from ._volume import Mesh, Volume
-from ._watch import Optics
+from ._watch import Optics, ProgressCallback, _progress
 
 
 def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_length: Optional[float] = None,
              aperture: Optional[float] = None, pixel: Optional[float] = None, distance: Optional[float] = None,
              focus: float = 0.0, source_distance: Optional[float] = None, pitch: Optional[float] = None,
              duty: float = 0.5, angle: float = 0.0, offset: float = 0.25, bands: Optional[int] = None,
-             samples: int = 6, seed: int = 1, chosen: bool = False) -> Tuple[Any, ...]:
+             samples: int = 6, seed: int = 1, chosen: bool = False,
+             progress: Union[None, bool, ProgressCallback] = None) -> Tuple[Any, ...]:
     """Focusing schlieren of ``volume`` (a lens-and-grid system, Weinstein
     1993), set up as ``rt focusing`` sets it up: the same defaults, the
     same automatic choices, the same image bit for bit. A source grid of
@@ -81,7 +82,9 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
 
     With ``chosen=True`` also the rig used, automatic choices included
     (the pitch among them), as an :class:`Optics` (last in the tuple):
-    ``rtvis.focusing(other, **chosen)`` repeats it exactly. Ctrl-C stops
+    ``rtvis.focusing(other, **chosen)`` repeats it exactly. ``progress``:
+    ``True`` draws a progress bar on stderr, a callable is called as
+    ``progress(done, total)`` (rays) on the calling thread. Ctrl-C stops
     the render within a fraction of a second (``KeyboardInterrupt``).
 
     Example: ``ref, flow, rel, info = rtvis.focusing(vol, focus=0.01,
@@ -106,6 +109,7 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
         None if bands is None else _uint("bands", bands),
         _uint("samples", samples),
         _uint("seed", seed, 64),
+        _progress(progress, "rtvis.focusing"),
     )
     result: Tuple[Any, ...] = (*out, said)
     if chosen:
