@@ -19,6 +19,7 @@ one-process render of the whole data. Rank 0's output holds the image, the
 other ranks' outputs are empty.
 """
 
+import json
 import math
 
 import numpy as np
@@ -101,6 +102,30 @@ def _world():
 
     comm = MPI.COMM_WORLD
     return comm.Get_rank(), comm.Get_size(), comm
+
+
+def _display_defaults():
+    """Shows the optics images as photographs rather than through a
+    colour map: grey, with fixed ranges (1 = the undisturbed background
+    at mid-grey for ``Intensity`` and ``Relative``, 0–1 for ``Fringes``,
+    ``Flow`` and ``Reference``), kept across time steps. ParaView picks a
+    lookup table by array name; these are settings for this session only,
+    below the user's and the site's own (which win), never saved."""
+    try:
+        from paraview.servermanager import vtkSMSettings
+    except ImportError:  # a process without the server manager
+        return
+
+    def grey(top):
+        return {"PVLookupTable": {"RGBPoints": [0.0, 0.0, 0.0, 0.0, top, 1.0, 1.0, 1.0], "ColorSpace": "RGB",
+                                  "AutomaticRescaleRangeMode": -1, "ScalarRangeInitialized": 1}}
+
+    tables = {"Intensity": grey(2.0), "Relative": grey(2.0), "Fringes": grey(1.0), "Flow": grey(1.0),
+              "Reference": grey(1.0)}
+    vtkSMSettings.GetInstance().AddCollectionFromString(json.dumps({"array_lookup_tables": tables}), 0.25)
+
+
+_display_defaults()
 
 
 class _Aborted(Exception):
@@ -300,8 +325,9 @@ class RTSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
     of a volume (density or refractive index) by rtvis: photons traced
     along curved paths through the field. Output: a 2-D image with
     ``Intensity`` (1 = undisturbed background; ``RGB`` for the colour
-    filter), ``Deflection`` (radians, along the image's axes) and, for
-    interferometry, ``Phase`` (radians, unwrapped)."""
+    filter; ``Fringes``, 0–1, and ``Phase``, radians unwrapped, for
+    interferometry) and ``Deflection`` (radians, along the image's axes),
+    shown in grey as a photograph (see ``_display_defaults``)."""
 
     def __init__(self):
         VTKPythonAlgorithmBase.__init__(self, nInputPorts=1, nOutputPorts=1, outputType="vtkImageData")
@@ -371,7 +397,8 @@ class RTSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
         if out is None:
             return 1
         img, eps, *phase = out
-        arrays = [("RGB" if img.ndim == 3 else "Intensity", img), ("Deflection", eps)]
+        name = "RGB" if img.ndim == 3 else "Fringes" if cutoff == "interferometry" else "Intensity"
+        arrays = [(name, img), ("Deflection", eps)]
         arrays += [("Phase", p) for p in phase]
         return self._image(out_info, image, arrays, "RT Schlieren")
 

@@ -20,14 +20,19 @@ try:
                               Function="1.2 + 0.3*exp(-(coordsX^2+coordsY^2+coordsZ^2)/128)")
         image = pvs.RTSchlieren(Input=bump, Array=["POINTS", "density"], Size=256)
         view = pvs.GetActiveViewOrCreate("RenderView")
-        display = pvs.Show(image, view)
-        pvs.ColorBy(display, ("POINTS", "Intensity"))
+        display = pvs.Show(image, view)  # coloured by its active scalars, Intensity
         view.InteractionMode = "2D"
         pvs.ResetCamera(view)
         pvs.Render(view)
         n = image.GetDataInformation().GetNumberOfPoints()
         msg.append(f"RT Schlieren applied and shown: {n} pixels")
-        ok = n == 256 * 256
+        # Shown as a photograph: grey, 0 to 2 (the background mid-grey),
+        # not rescaled to the data.
+        lut = pvs.GetColorTransferFunction("Intensity")
+        points = [round(float(x), 6) for x in lut.RGBPoints]
+        grey = points == [0.0, 0.0, 0.0, 0.0, 2.0, 1.0, 1.0, 1.0] and lut.AutomaticRescaleRangeMode == "Never"
+        msg.append(f"Intensity's colour map {points} ({lut.AutomaticRescaleRangeMode})")
+        ok = n == 256 * 256 and grey
         pvs.SaveScreenshot(os.path.join(out, "paraview-gui.png"), view, ImageResolution=[640, 480])
 except Exception:
     ok, msg = False, [traceback.format_exc()]

@@ -64,6 +64,7 @@ shadow = RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=5, Size=64)
 assert arrays(shadow)["Intensity"].std() > 0.01
 fringes = arrays(RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=6, Size=64, Wavelength=2e-4))
 assert fringes["Phase"].shape == (64, 64) and fringes["Phase"].max() > 2 * np.pi
+assert 0.0 <= fringes["Fringes"].min() and fringes["Fringes"].max() <= 1.0 and "Intensity" not in fringes
 print("RT Schlieren colour, shadowgraph and interferogram (with its phase): ok")
 
 # BOS and focusing schlieren: the same images as rtvis's from the same
