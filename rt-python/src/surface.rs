@@ -10,7 +10,7 @@ use pyo3::{
     exceptions::{PyMemoryError, PyRuntimeError},
     prelude::*,
 };
-use rt_core::{Camera, ColorMap, FrameError, Projection, intersect::Sphere};
+use rt_core::{Camera, ColorMap, ColorStop, FrameError, Projection, intersect::Sphere};
 use rt_surface::{
     Light, Material, Mesh, RenderError, Renderer, Settings,
     scene::{Glyphs, Paint, SurfaceScene, Tube},
@@ -23,25 +23,63 @@ use crate::{optics::filled, value_error, watch::watched};
 struct PaintSpec {
     /// One colour (linear RGB), or `None` to map the scalars.
     solid: Option<[f32; 3]>,
-    /// The colour map's name.
-    map: &'static str,
+    /// The colour map: a name, or the caller's own stops.
+    map: MapSpec,
     /// Scalar range of the colour map.
     range: (f32, f32),
 }
 
+/// A colour map by name, or the caller's stops (`(position, r, g, b)`,
+/// colours on the sRGB curve, as a table holds them).
+#[derive(Clone, Debug)]
+enum MapSpec {
+    Named(&'static str),
+    Stops(Vec<ColorStop>),
+}
+
 impl PaintSpec {
-    fn paint(&self) -> PyResult<Paint<'static>> {
+    fn paint(&self) -> PyResult<Paint<'_>> {
         if let Some(c) = self.solid {
             return Ok(Paint::Solid(c));
         }
-        let map = match self.map {
-            "viridis" => ColorMap::viridis(),
-            "grayscale" => ColorMap::grayscale(),
-            _ => ColorMap::cool_to_warm(),
-        };
         let (lo, hi) = self.range;
+        let map = match &self.map {
+            MapSpec::Named("viridis") => ColorMap::viridis(),
+            MapSpec::Named("grayscale") => ColorMap::grayscale(),
+            MapSpec::Named(_) => ColorMap::cool_to_warm(),
+            MapSpec::Stops(stops) => ColorMap::from_stops(stops, lo, hi)
+                .map_err(|e| value_error(format!("colormap: {e}")))?,
+        };
         Ok(Paint::Mapped(map.with_range(lo, hi).map_err(|e| value_error(format!("range: {e}")))?))
     }
+}
+
+/// The colour map `colormap` names, or its stops: an `(n, 4)` float32
+/// array of `(position in [0, 1], r, g, b)`.
+fn map_spec(colormap: &Bound<'_, PyAny>) -> PyResult<MapSpec> {
+    if let Ok(name) = colormap.extract::<String>() {
+        return match name.as_str() {
+            "viridis" => Ok(MapSpec::Named("viridis")),
+            "grayscale" => Ok(MapSpec::Named("grayscale")),
+            "cool_to_warm" => Ok(MapSpec::Named("cool_to_warm")),
+            other => Err(value_error(format!(
+                "colormap: unknown `{other}` (known: viridis, cool_to_warm, grayscale, or (n, 4) stops)"
+            ))),
+        };
+    }
+    let a: PyReadonlyArray2<'_, f32> = colormap.extract()?;
+    let a = a.as_array();
+    if a.ncols() != 4 || a.nrows() < 2 {
+        return Err(value_error(format!(
+            "colormap: expected (n, 4) stops (position, r, g, b), n ≥ 2; got {:?}",
+            a.dim()
+        )));
+    }
+    let stops: Vec<ColorStop> =
+        a.rows().into_iter().map(|r| ColorStop::rgb(r[0], r[1], r[2], r[3])).collect();
+    // Checked here, where the caller can be told which stop.
+    ColorMap::from_stops(&stops, 0.0, 1.0).map_err(|e| value_error(format!("colormap: {e}")))?;
+    Ok(MapSpec::Stops(stops))
 }
 
 /// One object of a scene.
@@ -89,20 +127,11 @@ fn read_scalars(a: Option<PyReadonlyArray1<'_, f32>>, n: usize) -> PyResult<Opti
 /// (default: the finite scalars' extent).
 fn paint_spec(
     color: Option<[f32; 3]>,
-    colormap: &str,
+    colormap: &Bound<'_, PyAny>,
     range: Option<(f32, f32)>,
     scalars: Option<&[f32]>,
 ) -> PyResult<PaintSpec> {
-    let map = match colormap {
-        "viridis" => "viridis",
-        "grayscale" => "grayscale",
-        "cool_to_warm" => "cool_to_warm",
-        other => {
-            return Err(value_error(format!(
-                "colormap: unknown `{other}` (known: viridis, cool_to_warm, grayscale)"
-            )));
-        }
-    };
+    let map = map_spec(colormap)?;
     if let Some(c) = color.filter(|c| !c.iter().all(|v| v.is_finite() && *v >= 0.0)) {
         return Err(value_error(format!("color must be finite and ≥ 0 (got {c:?})")));
     }
@@ -157,7 +186,7 @@ impl PyScene {
         triangles: PyReadonlyArray2<'_, i64>,
         scalars: Option<PyReadonlyArray1<'_, f32>>,
         color: Option<[f32; 3]>,
-        colormap: &str,
+        colormap: &Bound<'_, PyAny>,
         range: Option<(f32, f32)>,
         material: [f32; 5],
         smooth: bool,
@@ -203,7 +232,7 @@ impl PyScene {
         radii: PyReadonlyArray1<'_, f32>,
         scalars: Option<PyReadonlyArray1<'_, f32>>,
         color: Option<[f32; 3]>,
-        colormap: &str,
+        colormap: &Bound<'_, PyAny>,
         range: Option<(f32, f32)>,
         material: [f32; 5],
     ) -> PyResult<()> {
@@ -237,7 +266,7 @@ impl PyScene {
         radius: f32,
         scalars: Option<PyReadonlyArray1<'_, f32>>,
         color: Option<[f32; 3]>,
-        colormap: &str,
+        colormap: &Bound<'_, PyAny>,
         range: Option<(f32, f32)>,
         material: [f32; 5],
     ) -> PyResult<()> {

@@ -135,3 +135,33 @@ def test_save_png_makes_its_folder_and_refuses_a_folder(tmp_path, capsys):
         rtvis.save_png(tmp_path / "new", img)
     # Nothing but the image is left in the folder (no staging file).
     assert [p.name for p in target.parent.iterdir()] == ["a.png"]
+
+
+def test_a_colour_map_of_your_own_stops():
+    # The grayscale map's own stops given as an array: the same image as
+    # the named map, bit for bit; a red-to-blue map paints the low end red.
+    centers = np.array([[-1.5, 0, 0], [0, 0, 0], [1.5, 0, 0]], np.float32)
+    scalars = np.array([0.0, 0.5, 1.0], np.float32)
+    cam = rtvis.Camera.fit(((-2.5, -1, -1), (2.5, 1, 1)), aspect=96 / 40)
+    lights = [("ambient", (1.0, 1.0, 1.0))]
+
+    def render(colormap):
+        scene = rtvis.Scene().add_spheres(centers, 0.6, scalars=scalars, colormap=colormap, material="matte")
+        return scene.render(cam, size=(96, 40), lights=lights, shadows=False)[0]
+
+    named = render("grayscale")
+    stops = np.array([[0, 0, 0, 0], [1, 1, 1, 1]], np.float32)
+    assert np.array_equal(render(stops), named)
+    red_blue = render(np.array([[0, 1, 0, 0], [1, 0, 0, 1]], np.float32))
+    hit = red_blue[..., 3] > 0.99
+    assert hit.mean() > 0.02
+    cols = np.nonzero(hit.any(axis=0))[0]
+    a, b = cols.min() + (cols.max() - cols.min()) // 5, cols.max() - (cols.max() - cols.min()) // 5
+    left = red_blue[:, :a][hit[:, :a]].mean(axis=0)  # the sphere of scalar 0
+    right = red_blue[:, b:][hit[:, b:]].mean(axis=0)  # the sphere of scalar 1
+    assert left[0] > 0.3 and left[2] < 0.1 * left[0], left
+    assert right[2] > 0.3 and right[0] < 0.1 * right[2], right
+    with pytest.raises(ValueError, match="colormap"):
+        render(np.array([[0.5, 1, 0, 0], [0.2, 0, 0, 1]], np.float32))  # positions fall
+    with pytest.raises(ValueError, match="colormap"):
+        render(np.array([[0, 1, 0, 0]], np.float32))

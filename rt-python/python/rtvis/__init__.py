@@ -102,6 +102,7 @@ __all__ = [
     "shadowgraph",
     "to_gray8",
     "to_srgb8",
+    "DEFAULT_LIGHTS",
 ]
 
 __version__ = "0.1.0"

@@ -84,16 +84,25 @@ def _material(m: _Material) -> Tuple[float, ...]:
     raise TypeError(f"material: expected 'matte', 'glossy' or a dict, got {type(m).__name__}")
 
 
-def _paint_args(n: int, scalars: Optional[ArrayLike], color: Optional[ArrayLike], colormap: str,
+Colormap = Union[str, ArrayLike]
+"""A colour map: a name (``cool_to_warm``, ``viridis``, ``grayscale``) or
+stops, an (n, 4) array of ``(position, r, g, b)``: positions rising from
+0 to 1 across the range, colours 0–1 on the sRGB curve (a table's 8-bit
+values divided by 255), interpolated linearly between stops."""
+
+
+def _paint_args(n: int, scalars: Optional[ArrayLike], color: Optional[ArrayLike], colormap: Colormap,
                 range: Optional[ArrayLike]
-                ) -> Tuple[Optional[NDArray[np.float32]], Optional[Tuple[float, float, float]], str,
+                ) -> Tuple[Optional[NDArray[np.float32]], Optional[Tuple[float, float, float]], Any,
                            Optional[Tuple[float, float]]]:
     s = None
     if scalars is not None:
         s = np.ascontiguousarray(_array_allow_nan("scalars", scalars, n), dtype=np.float32)
     c = None if color is None else _vector("color", color)
     r = None if range is None else _vector("range", range, 2)
-    return s, c, _choice("colormap", colormap, _COLORMAPS), r
+    cm: Any = _choice("colormap", colormap, _COLORMAPS) if isinstance(colormap, str) \
+        else _array("colormap", colormap, 2, np.float32, last=4)
+    return s, c, cm, r
 
 
 def _array_allow_nan(name: str, value: ArrayLike, n: int) -> NDArray[Any]:
@@ -113,7 +122,8 @@ class Scene:
 
     Colouring: ``color`` (linear RGB, each 0–1) paints an object one
     colour; otherwise its ``scalars`` go through ``colormap``
-    (``cool_to_warm``, ``viridis``, ``grayscale``) over ``range`` (default:
+    (``cool_to_warm``, ``viridis``, ``grayscale``, or your own stops: see
+    :data:`Colormap`) over ``range`` (default:
     the scalars' own finite extent; give the same range to every rank or
     piece). ``material`` is ``"matte"``, ``"glossy"`` or a dict of
     ``diffuse``, ``specular``, ``shininess``, ``opacity``, ``mirror``.
@@ -123,7 +133,7 @@ class Scene:
         self._s = _rtvis._Scene()
 
     def add_mesh(self, points: ArrayLike, triangles: ArrayLike, scalars: Optional[ArrayLike] = None,
-                 color: Optional[ArrayLike] = None, colormap: str = "cool_to_warm", range: Optional[ArrayLike] = None,
+                 color: Optional[ArrayLike] = None, colormap: Colormap = "cool_to_warm", range: Optional[ArrayLike] = None,
                  material: _Material = "glossy", smooth: bool = True, normals: Optional[ArrayLike] = None) -> "Scene":
         """Adds a triangle mesh: ``points`` (n, 3), ``triangles`` (m, 3)
         integer indices into the points, ``scalars`` (n,) per point.
@@ -142,7 +152,7 @@ class Scene:
         return self
 
     def add_spheres(self, centers: ArrayLike, radii: ArrayLike, scalars: Optional[ArrayLike] = None,
-                    color: Optional[ArrayLike] = None, colormap: str = "cool_to_warm",
+                    color: Optional[ArrayLike] = None, colormap: Colormap = "cool_to_warm",
                     range: Optional[ArrayLike] = None, material: _Material = "glossy") -> "Scene":
         """Adds sphere glyphs: ``centers`` (n, 3), ``radii`` one number or
         (n,), ``scalars`` (n,)."""
@@ -154,7 +164,7 @@ class Scene:
         return self
 
     def add_tubes(self, polyline: ArrayLike, radius: float, scalars: Optional[ArrayLike] = None,
-                  color: Optional[ArrayLike] = None, colormap: str = "cool_to_warm",
+                  color: Optional[ArrayLike] = None, colormap: Colormap = "cool_to_warm",
                   range: Optional[ArrayLike] = None, material: _Material = "glossy") -> "Scene":
         """Adds a tube of ``radius`` along ``polyline`` ((n, 3) points,
         n ≥ 2), or one tube per polyline given a list of them (then
