@@ -37,15 +37,28 @@ for n in 1 2 3 4; do
         pvbatch --symmetric "$here/pvbatch_surface.py" "$out" 2>&1 | grep -E "ranks|Error|error" || true
     test -s "$out/surface-$n.npz"
 done
+echo "-- rtvis_view: a render view ray traced, against ParaView's own raster (xvfb-run)"
+PYTHONPATH="$plugin_dir:$site" timeout 300 xvfb-run -a pvpython "$here/pvpython_view.py" "$out" 2>&1 \
+    | grep -E "coverage|colour|rtvis_view|wrote|Error|error"
+test -s "$out/view-rtvis-lit.png"
+
+echo "-- rtvis_view under mpirun: 1 to 4 ranks, each its piece, composited"
+for n in 1 2 3 4; do
+    PYTHONPATH="$plugin_dir:$site" timeout 300 mpirun --oversubscribe -np "$n" \
+        pvbatch --symmetric "$here/pvbatch_view.py" "$out" 2>&1 | grep -E "ranks|Error|error" || true
+    test -s "$out/view-$n.npz"
+done
+
 /usr/bin/python3 - "$out" <<'PY'
 import sys
 import numpy as np
 out = sys.argv[1]
-ref = np.load(f"{out}/surface-1.npz")
-for n in (2, 3, 4):
-    d = np.load(f"{out}/surface-{n}.npz")
+for kind in ("surface", "view"):
+  ref = np.load(f"{out}/{kind}-1.npz")
+  for n in (2, 3, 4):
+    d = np.load(f"{out}/{kind}-{n}.npz")
     same = np.array_equal(d["rgba"], ref["rgba"]) and np.array_equal(d["depth"], ref["depth"])
-    print(f"{n} ranks vs 1 rank: {'bit for bit equal' if same else 'DIFFERENT'}")
+    print(f"{kind}: {n} ranks vs 1 rank: {'bit for bit equal' if same else 'DIFFERENT'}")
     if not same:
         sys.exit(1)
 PY
