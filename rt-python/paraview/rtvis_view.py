@@ -273,4 +273,47 @@ def save(path, view=None, **options):
     return rgba, depth
 
 
-__all__ = ["camera_of", "raytrace", "save"]
+_PANE = """\
+# A ray-traced copy of the render view {name!r} (rtvis_view.show).
+def setup_data(view):
+    pass
+
+
+def render(view, width, height):
+    import numpy as np
+    import paraview.simple as pvs
+    from paraview import python_view
+    import rtvis
+    import rtvis_view
+
+    source = pvs.FindView({name!r})
+    if source is None:
+        return None
+    rgba, _ = rtvis_view.raytrace(source, size=(width, height), **{options!r})
+    rgb = rtvis.to_srgb8(rgba, background=rtvis_view._linear(source.Background))
+    image = np.dstack([rgb, np.full(rgb.shape[:2], 255, np.uint8)])[::-1]
+    return python_view.numpy_to_image(np.ascontiguousarray(image))
+"""
+
+
+def show(view=None, **options):
+    """A Python view (ParaView's ``PythonView``) beside ``view`` (default:
+    the active render view) that shows it ray traced, ``raytrace``'s
+    ``options`` applied (``shadows``, ``ao``, ``passes``, ``lights``), at
+    the pane's own size; it re-traces whenever ParaView renders it (a
+    change of the pipeline, the pane resized). In one process (the GUI
+    without a server, pvpython). Returns the Python view."""
+    import paraview.simple as pvs
+    from paraview import servermanager
+
+    view = view or pvs.GetActiveView()
+    name = servermanager.ProxyManager().GetProxyName("views", view)
+    unknown = set(options) - {"shadows", "ao", "passes", "lights", "seed"}
+    if unknown:
+        raise TypeError(f"rtvis_view.show: unknown options {sorted(unknown)}")
+    pane = pvs.CreateView("PythonView")
+    pane.Script = _PANE.format(name=name, options=options)
+    return pane
+
+
+__all__ = ["camera_of", "raytrace", "save", "show"]

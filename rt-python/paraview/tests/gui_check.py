@@ -34,6 +34,26 @@ try:
         msg.append(f"Intensity's colour map {points} ({lut.AutomaticRescaleRangeMode})")
         ok = n == 256 * 256 and grey
         pvs.SaveScreenshot(os.path.join(out, "paraview-gui.png"), view, ImageResolution=[640, 480])
+        # The view ray traced in a pane of the GUI (rtvis_view.show): a
+        # contour coloured by elevation, traced with shadows.
+        import numpy as np
+        import rtvis_view
+
+        pvs.Hide(image, view)
+        contour = pvs.Contour(Input=src, ContourBy=["POINTS", "RTData"], Isosurfaces=[150.0])
+        shown = pvs.Show(pvs.Elevation(Input=contour, LowPoint=[0, -10, 0], HighPoint=[0, 10, 0]), view)
+        pvs.ColorBy(shown, ("POINTS", "Elevation"))
+        view.InteractionMode = "3D"
+        pvs.ResetCamera(view)
+        pane = rtvis_view.show(view, shadows=True, ao=4)
+        pvs.AssignViewToLayout(pane)
+        pvs.Render(pane)
+        # At the pane's own size: a Python view's image is not magnified.
+        pvs.SaveScreenshot(os.path.join(out, "paraview-gui-pane.png"), pane)
+        rgba, depth = rtvis_view.raytrace(view, size=(320, 240))
+        covered = float(np.isfinite(depth).mean())
+        msg.append(f"the view ray traced in a pane: {covered:.0%} of pixels covered")
+        ok = ok and 0.05 < covered < 0.95
 except Exception:
     ok, msg = False, [traceback.format_exc()]
 with open(os.path.join(out, "gui-result.txt"), "w") as fh:
