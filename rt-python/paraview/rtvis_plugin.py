@@ -93,6 +93,12 @@ def _selected_array(algorithm, data):
     return (data.GetCellData() if cells else data.GetPointData()).GetArray(name)
 
 
+def _rank():
+    """(rank, size) of ParaView's processes (0, 1 without MPI)."""
+    ctrl = vtkMultiProcessController.GetGlobalController()
+    return (ctrl.GetLocalProcessId(), ctrl.GetNumberOfProcesses()) if ctrl else (0, 1)
+
+
 def _world():
     """(rank, size, mpi4py communicator or None) of ParaView's processes."""
     ctrl = vtkMultiProcessController.GetGlobalController()
@@ -236,11 +242,27 @@ class _VolumeInput:
         return 1
 
     def RequestUpdateExtent(self, request, in_info, out_info):
-        # The whole volume, whatever part of the image is asked for.
-        info = in_info[0].GetInformationObject(0)
-        info.Set(vtkStreamingDemandDrivenPipeline.UPDATE_EXTENT(),
-                 info.Get(vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT()), 6)
+        # Rank 0 renders: it asks for the whole volume as one piece (a
+        # reader under MPI would otherwise hand it its piece only); the
+        # other ranks keep their own piece, unused, and output nothing,
+        # so N ranks take one rank's time instead of N renders contending
+        # for the cores.
+        rank, _ = _rank()
+        if rank == 0:
+            sddp = vtkStreamingDemandDrivenPipeline
+            info = in_info[0].GetInformationObject(0)
+            info.Set(sddp.UPDATE_PIECE_NUMBER(), 0)
+            info.Set(sddp.UPDATE_NUMBER_OF_PIECES(), 1)
+            info.Set(sddp.UPDATE_EXTENT(), info.Get(sddp.WHOLE_EXTENT()), 6)
         return 1
+
+    def _idle(self, out_info):
+        """True on a rank other than 0, its output left empty (see
+        ``RequestUpdateExtent``)."""
+        if _rank()[0] == 0:
+            return False
+        vtkImageData.GetData(out_info).SetExtent(0, -1, 0, -1, 0, -1)
+        return True
 
     def _volume(self, in_info, label):
         """The rtvis.Volume of the chosen array; the image's geometry."""
@@ -381,6 +403,8 @@ class RTSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
     def RequestData(self, request, in_info, out_info):
         import rtvis
 
+        if self._idle(out_info):
+            return 1
         vol, image = self._volume(in_info, "RT Schlieren")
         cutoff = _CUTOFFS[self._cutoff]
         common = dict(axis=_AXES[self._axis], size=self._size, photons=self._photons, seed=self._seed,
@@ -471,6 +495,8 @@ class RTBOS(_VolumeInput, VTKPythonAlgorithmBase):
     def RequestData(self, request, in_info, out_info):
         import rtvis
 
+        if self._idle(out_info):
+            return 1
         vol, image = self._volume(in_info, "RT BOS")
         options = dict(axis=_AXES[self._axis], size=self._size, seed=self._seed, f_number=self._fnumber,
                        focal_length=self._focal or None, pixel=self._pixel or None,
@@ -554,6 +580,8 @@ class RTFocusingSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
     def RequestData(self, request, in_info, out_info):
         import rtvis
 
+        if self._idle(out_info):
+            return 1
         vol, image = self._volume(in_info, "RT Focusing Schlieren")
         options = dict(axis=_AXES[self._axis], size=self._size, seed=self._seed, focus=self._focus,
                        aperture=self._aperture or None, focal_length=self._focal or None,
@@ -703,8 +731,7 @@ class RTSurfaceRender(VTKPythonAlgorithmBase):
     def RequestUpdateExtent(self, request, in_info, out_info):
         # This process's piece of the input, whatever part of the image is
         # asked for (the image is whole on rank 0).
-        ctrl = vtkMultiProcessController.GetGlobalController()
-        rank, size = (ctrl.GetLocalProcessId(), ctrl.GetNumberOfProcesses()) if ctrl else (0, 1)
+        rank, size = _rank()
         info = in_info[0].GetInformationObject(0)
         sddp = vtkStreamingDemandDrivenPipeline
         info.Set(sddp.UPDATE_PIECE_NUMBER(), rank)

@@ -49,6 +49,25 @@ for n in 1 2 3 4; do
     test -s "$out/view-$n.npz"
 done
 
+echo "-- the optics filters under mpirun with ParaView's XML reader: 1 to 4 ranks"
+for n in 1 2 3 4; do
+    PYTHONPATH="$plugin_dir:$site" timeout 300 mpirun --oversubscribe -np "$n" \
+        pvbatch --symmetric "$here/pvbatch_optics.py" "$out" 2>&1 | grep -E "ranks|Error|error" || true
+    test -s "$out/optics-$n.npz"
+done
+/usr/bin/python3 - "$out" <<'PY'
+import sys
+import numpy as np
+out = sys.argv[1]
+ref = np.load(f"{out}/optics-1.npz")
+for n in (2, 3, 4):
+    d = np.load(f"{out}/optics-{n}.npz")
+    same = all(np.array_equal(d[k], ref[k]) for k in ref.files) and set(d.files) == set(ref.files)
+    print(f"optics: {n} ranks vs 1 rank: {'bit for bit equal' if same else 'DIFFERENT'} ({', '.join(ref.files)})")
+    if not same:
+        sys.exit(1)
+PY
+
 /usr/bin/python3 - "$out" <<'PY'
 import sys
 import numpy as np
