@@ -355,7 +355,7 @@ class RTSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
         VTKPythonAlgorithmBase.__init__(self, nInputPorts=1, nOutputPorts=1, outputType="vtkImageData")
         self._cutoff, self._angle = 0, 0.0
         self._f, self._h, self._film, self._wavelength, self._fringes = 1.0, 0.0, 0.0, 10.6e-6, 0.0
-        self._photons = 16
+        self._photons, self._across = 16, 1
 
     @_enum("Cutoff", "SetCutoff", ["Knife edge", "Graded filter", "Pinhole", "Dark field", "Colour (hue wheel)",
                                    "None (shadowgraph)", "Interferometry"], 0, "The optical set-up.")
@@ -400,9 +400,92 @@ class RTSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
     def SetPhotons(self, v):
         self._set("_photons", int(v))
 
+    @smproperty.intvector(name="AcrossRanks", default_values=[1])
+    @smdomain.xml('<BooleanDomain name="bool"/>')
+    @_doc("Under MPI (pvbatch, pvserver): each rank reads only its brick of the volume and photons are handed from rank to rank (knife edge at 0° with its height chosen, or interferometry; beam along z; point data). The knife edge is then chosen from the photons' deflections, not from a survey: the image is the same on any number of ranks, not the one process's of pvpython. Off: rank 0 reads the whole volume.")
+    def SetAcrossRanks(self, v):
+        self._set("_across", int(v))
+
+    def _pieces(self):
+        """Whether this render hands photons across ranks (AcrossRanks)."""
+        # pvbatch and pvserver ranks, at any count; not pvpython or the
+        # GUI's built-in server (MPI-enabled too, but one process).
+        from paraview.modules.vtkRemotingCore import vtkProcessModule
+
+        kind = vtkProcessModule.GetProcessType()
+        ranks = (vtkProcessModule.PROCESS_BATCH, vtkProcessModule.PROCESS_SERVER,
+                 vtkProcessModule.PROCESS_DATA_SERVER)
+        ctrl = vtkMultiProcessController.GetGlobalController()
+        mpi = kind in ranks and ctrl is not None and ctrl.IsA("vtkMPIController")
+        knife = _CUTOFFS[self._cutoff] == "knife" and self._angle == 0.0 and self._h == 0.0 and self._film == 0.0
+        fringes = _CUTOFFS[self._cutoff] == "interferometry" and self._film == 0.0
+        cells = self.GetInputArrayInformation(0).Get(vtkDataObject.FIELD_ASSOCIATION()) == \
+            vtkDataObject.FIELD_ASSOCIATION_CELLS
+        return bool(self._across) and mpi and self._axis == 2 and (knife or fringes) and not cells
+
+    def _whole(self, in_info):
+        """The whole grid: (whole extent, shape (nz, ny, nx), spacing,
+        origin of its first sample)."""
+        info = in_info[0].GetInformationObject(0)
+        ext = info.Get(vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT())
+        spacing = tuple(float(v) for v in info.Get(vtkDataObject.SPACING()))
+        origin = tuple(o + h * e for o, h, e in zip(info.Get(vtkDataObject.ORIGIN()), spacing, ext[::2]))
+        shape = (ext[5] - ext[4] + 1, ext[3] - ext[2] + 1, ext[1] - ext[0] + 1)
+        return ext, shape, spacing, origin
+
+    def RequestUpdateExtent(self, request, in_info, out_info):
+        if not self._pieces():
+            return _VolumeInput.RequestUpdateExtent(self, request, in_info, out_info)
+        import rtvis
+
+        # This rank's brick and its ghost layers, as one piece.
+        ext, shape, spacing, origin = self._whole(in_info)
+        rank, size = _rank()
+        (z0, y0, x0), (z1, y1, x1) = rtvis.brick_box(shape, size, rank, spacing, origin,
+                                                     ["linear", "cubic"][self._cubic])
+        sddp = vtkStreamingDemandDrivenPipeline
+        info = in_info[0].GetInformationObject(0)
+        info.Set(sddp.UPDATE_PIECE_NUMBER(), 0)
+        info.Set(sddp.UPDATE_NUMBER_OF_PIECES(), 1)
+        info.Set(sddp.UPDATE_EXTENT(), ext[0] + x0, ext[0] + x1 - 1, ext[2] + y0, ext[2] + y1 - 1,
+                 ext[4] + z0, ext[4] + z1 - 1)
+        return 1
+
+    def _across_ranks(self, in_info, out_info):
+        """The image with photons handed across ranks (``_pieces``)."""
+        import rtvis
+        from mpi4py import MPI
+
+        ext, shape, spacing, origin = self._whole(in_info)
+        data = vtkImageData.GetData(in_info[0], 0)
+        array = _selected_array(self, data)
+        if array is None:
+            raise ValueError("RT Schlieren: choose a scalar array (Array)")
+        e = data.GetExtent()
+        piece = numpy_support.vtk_to_numpy(array).reshape(e[5] - e[4] + 1, e[3] - e[2] + 1, e[1] - e[0] + 1)
+        start = (e[4] - ext[4], e[2] - ext[2], e[0] - ext[0])
+        fringes = _CUTOFFS[self._cutoff] == "interferometry"
+        image = rtvis.schlieren_pieces(
+            piece, start, shape, MPI.COMM_WORLD, spacing=spacing, origin=origin,
+            quantity=["density", "index"][self._quantity], k=self._k, interpolation=["linear", "cubic"][self._cubic],
+            cutoff="interferometry" if fringes else "knife", wavelength=self._wavelength,
+            fringe_spacing=self._fringes or None, size=self._size,
+            strata=max(1, math.ceil(math.sqrt(self._photons))), seed=self._seed)
+        if image is None:
+            vtkImageData.GetData(out_info).SetExtent(0, -1, 0, -1, 0, -1)
+            return 1
+        ranks = MPI.COMM_WORLD.Get_size()
+        self._chosen = f"across {ranks} ranks: " + (
+            f"interferometry, λ = {self._wavelength} m" if fringes
+            else "knife edge at 0°, its height from the photons' deflections (0.5 ± 0.45 at the 99th percentile)")
+        *_, geometry = self._geometry(in_info)
+        return self._image(out_info, geometry, [("Fringes" if fringes else "Intensity", image)], "RT Schlieren")
+
     def RequestData(self, request, in_info, out_info):
         import rtvis
 
+        if self._pieces():
+            return self._across_ranks(in_info, out_info)
         if self._idle(out_info):
             return 1
         vol, image = self._volume(in_info, "RT Schlieren")

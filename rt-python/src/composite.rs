@@ -98,7 +98,7 @@ pub(crate) fn composite<'py>(
 /// `rank()`, `size()`, `send(to, tag, data: bytes)` and `recv(source,
 /// tag) -> bytes` (rtvis wraps an `mpi4py` communicator so): the
 /// compositing schedule runs in Rust, the transport is the caller's MPI.
-struct PyComm {
+pub(crate) struct PyComm {
     obj: Py<PyAny>,
     rank: usize,
     size: usize,
@@ -107,6 +107,23 @@ struct PyComm {
 }
 
 impl PyComm {
+    /// The communicator `obj` (an rtvis wrapper of an mpi4py one).
+    pub(crate) fn new(py: Python<'_>, obj: Py<PyAny>) -> PyResult<Self> {
+        let rank: usize = obj.call_method0(py, "rank")?.extract(py)?;
+        let size: usize = obj.call_method0(py, "size")?.extract(py)?;
+        Ok(Self { obj, rank, size, error: Mutex::new(None) })
+    }
+
+    /// This rank's number.
+    pub(crate) fn rank_number(&self) -> usize {
+        self.rank
+    }
+
+    /// The first Python exception a call raised, if any.
+    pub(crate) fn cause(&self) -> Option<String> {
+        self.error.lock().ok().and_then(|g| g.clone())
+    }
+
     /// Remembers `e` (the first one) and maps it to a [`CommError`].
     fn fail(&self, py: Python<'_>, e: &PyErr, timeout: CommError) -> CommError {
         if let Ok(mut first) = self.error.lock() {

@@ -9,6 +9,7 @@
 //! user data, and a panic would surface as Python's `PanicException`, not
 //! an abort.
 
+mod bricks;
 mod composite;
 mod optics;
 mod surface;
@@ -35,6 +36,8 @@ fn _rtvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<surface::PyScene>()?;
     m.add_function(wrap_pyfunction!(composite::composite, m)?)?;
     m.add_function(wrap_pyfunction!(composite::composite_comm, m)?)?;
+    m.add_function(wrap_pyfunction!(bricks::brick_box, m)?)?;
+    m.add_function(wrap_pyfunction!(bricks::schlieren_piece, m)?)?;
     m.add("GLADSTONE_DALE_AIR", rt_volume::GLADSTONE_DALE_AIR)?;
     Ok(())
 }

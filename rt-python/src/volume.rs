@@ -32,7 +32,7 @@ impl PyVolume {
 }
 
 /// What `quantity` (with constant `k`) names.
-fn samples(quantity: &str, k: f64) -> PyResult<Samples> {
+pub(crate) fn samples(quantity: &str, k: f64) -> PyResult<Samples> {
     match quantity {
         "density" => Ok(Samples::Density { gladstone_dale: k }),
         "index" => Ok(Samples::Index),
@@ -41,7 +41,7 @@ fn samples(quantity: &str, k: f64) -> PyResult<Samples> {
 }
 
 /// The interpolant `interpolation` names.
-fn interp(interpolation: &str) -> PyResult<Interp> {
+pub(crate) fn interp(interpolation: &str) -> PyResult<Interp> {
     match interpolation {
         "linear" => Ok(Interp::Trilinear),
         "cubic" => Ok(Interp::CatmullRom),

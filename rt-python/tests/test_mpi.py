@@ -39,3 +39,17 @@ def test_a_silent_rank_is_an_error_on_the_others_not_a_hang():
     assert r.returncode == 0, r.stdout + r.stderr
     for rank in (0, 2):
         assert f"rank {rank}: ValueError: compositing failed" in r.stdout, r.stdout + r.stderr
+
+
+PIECES = Path(__file__).with_name("mpi_pieces.py")
+
+
+@needs_mpi
+@pytest.mark.parametrize("n", [1, 2, 3, 4])
+@pytest.mark.parametrize("cutoff", ["knife", "interferometry"])
+def test_schlieren_of_pieces_equals_the_whole_grid_bit_for_bit(n, cutoff):
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    r = subprocess.run([mpirun, "--oversubscribe", "-np", str(n), sys.executable, str(PIECES), cutoff],
+                       capture_output=True, text=True, timeout=300, env=env)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert f"{cutoff}: {n} ranks OK" in r.stdout, r.stdout + r.stderr

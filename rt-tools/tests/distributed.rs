@@ -218,3 +218,55 @@ fn a_rank_that_stops_answering_is_an_error_on_every_rank() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Each rank handed only its piece of the grid, as ParaView hands a rank
+/// its extent (here cut from the file in memory, each the box
+/// `first_brick_box` names): the same film as one process, bit for bit;
+/// a piece short of its ghost layers is refused by name, not traced wrong.
+#[test]
+fn pieces_held_in_memory_equal_one_process_bit_for_bit() {
+    let dir = std::env::temp_dir().join(format!("rt-tools-test-pieces-{}", std::process::id()));
+    let job = volume::builtin(&dir, 32, 1).unwrap();
+    let info = rt_volume::io::read_grid_info(&job.file).unwrap();
+    let grid = rt_volume::io::read_grid_box(&job.file, [0; 3], info.dims).unwrap();
+    let whole = volume::single(&job).unwrap();
+    let piece = |lo: [usize; 3], hi: [usize; 3]| {
+        let dims = [0, 1, 2].map(|a| hi[a] - lo[a]);
+        let mut samples = Vec::new();
+        for k in lo[2]..hi[2] {
+            for j in lo[1]..hi[1] {
+                let row = (k * info.dims[1] + j) * info.dims[0];
+                samples.extend_from_slice(&grid.data()[row + lo[0]..row + hi[0]]);
+            }
+        }
+        volume::Piece { info, lo, dims, samples, first: grid.data()[0] }
+    };
+    for ranks in [1usize, 2, 3, 4] {
+        let (film, reports) = on_ranks(ranks, |c| {
+            let (lo, hi) = volume::first_brick_box(info, job.interp, ranks, c.rank())?;
+            Ok(volume::rank_from(c, &job, &piece(lo, hi))?)
+        });
+        assert!(volume::same(&film, &whole), "{ranks} ranks: the films differ");
+        if ranks > 1 {
+            assert!(reports.iter().all(|r| r.brick_samples < r.grid_samples));
+        }
+    }
+    // Pieces one layer short on every side: refused.
+    let comms = ThreadComm::group(2, Duration::from_secs(20));
+    let errors: Vec<String> = std::thread::scope(|s| {
+        let handles: Vec<_> = comms
+            .into_iter()
+            .map(|c| {
+                let (job, piece) = (&job, &piece);
+                s.spawn(move || {
+                    let (lo, hi) = volume::first_brick_box(info, job.interp, 2, c.rank()).unwrap();
+                    let lo = lo.map(|v| v + 1);
+                    let hi = hi.map(|v| v - 1);
+                    volume::rank_from(&c, job, &piece(lo, hi)).err().map(|e| e.to_string())
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap().unwrap_or_default()).collect()
+    });
+    assert!(errors.iter().any(|e| e.contains("too few ghost layers")), "{errors:?}");
+}

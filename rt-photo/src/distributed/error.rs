@@ -62,6 +62,15 @@ pub enum DistributedError {
     },
     /// Rank 0 holds no result for a photon the bench emits.
     MissingResult,
+    /// A [`super::Piece`] lacks samples the run reads.
+    Piece {
+        /// First sample asked for.
+        lo: [usize; 3],
+        /// One past the last sample asked for.
+        hi: [usize; 3],
+        /// The piece's first sample and samples per axis.
+        held: ([usize; 3], [usize; 3]),
+    },
 }
 
 impl fmt::Display for DistributedError {
@@ -89,6 +98,10 @@ impl fmt::Display for DistributedError {
             Self::Malformed { from } => write!(f, "rank {from} sent a malformed batch"),
             Self::Exchange { rank, message } => write!(f, "rank {rank}: {message}"),
             Self::MissingResult => f.write_str("rank 0: a photon's result is missing"),
+            Self::Piece { lo, hi, held: (at, dims) } => write!(
+                f,
+                "samples {lo:?}..{hi:?} are needed, the piece holds {dims:?} from {at:?} (too few ghost layers)"
+            ),
         }
     }
 }

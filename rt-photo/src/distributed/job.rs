@@ -83,15 +83,19 @@ impl VolumeJob {
         2 + 8 + batch * PHOTON_BYTES + 8 + batch * RESULT_BYTES
     }
 
-    /// The samples `lo..hi` of the file, as index.
+    /// The samples `lo..hi` of `source`, as index.
     pub(crate) fn read_box(
         &self,
+        source: &dyn BrickSource,
         lo: [usize; 3],
         hi: [usize; 3],
     ) -> Result<Grid, DistributedError> {
-        let grid = io::read_grid_box(&self.file, lo, hi)?;
-        // Non-physical samples are the user's to judge here (the ranks
-        // read bricks, not the whole volume's range).
+        self.to_index(source.read(lo, hi)?)
+    }
+
+    /// Samples as index. Non-physical samples are the user's to judge
+    /// here (the ranks read bricks, not the whole volume's range).
+    fn to_index(&self, grid: Grid) -> Result<Grid, DistributedError> {
         self.samples.grid_to_index(grid, true).map_err(|e| {
             let path = self.file.clone();
             DistributedError::Samples(MediumError::InFile {
@@ -103,17 +107,107 @@ impl VolumeJob {
 
     /// The whole grid's header, and the index outside the volume (its
     /// first sample's, as a medium takes it).
-    pub(crate) fn header(&self) -> Result<(GridInfo, f64), DistributedError> {
+    pub(crate) fn header(
+        &self,
+        source: &dyn BrickSource,
+    ) -> Result<(GridInfo, f64), DistributedError> {
+        let info = source.info()?;
+        let first = Grid::new([1; 3], info.origin, info.spacing, alloc::vec![source.first()?])?;
+        let ambient = f64::from(self.to_index(first)?.data()[0]);
+        Ok((info, ambient))
+    }
+}
+
+/// Where a rank's samples come from: the job's file, read a box at a time
+/// (a [`VolumeJob`] is one), or the piece of the grid the caller holds (a
+/// [`Piece`]: what a ParaView rank is handed).
+pub trait BrickSource: Sync {
+    /// The whole grid's header.
+    ///
+    /// # Errors
+    /// An unreadable or unsupported file.
+    fn info(&self) -> Result<GridInfo, DistributedError>;
+
+    /// The raw samples `lo..hi` (sample indices, `hi` exclusive) as a
+    /// grid whose origin is sample `lo`'s centre.
+    ///
+    /// # Errors
+    /// Samples the source does not hold or cannot read.
+    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Grid, DistributedError>;
+
+    /// Sample `(0, 0, 0)`, raw: the medium around the volume.
+    ///
+    /// # Errors
+    /// As [`BrickSource::read`].
+    fn first(&self) -> Result<f32, DistributedError> {
+        Ok(self.read([0; 3], [1; 3])?.data()[0])
+    }
+}
+
+impl BrickSource for VolumeJob {
+    fn info(&self) -> Result<GridInfo, DistributedError> {
         let ext = self.file.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         if !matches!(ext.as_deref(), Some("json" | "raw" | "nrrd" | "nhdr")) {
             return Err(DistributedError::Format(self.file.clone()));
         }
-        let info = io::read_grid_info(&self.file)?;
-        let first = self.read_box([0; 3], [1; 3])?;
-        let ambient = f64::from(first.data()[0]);
-        Ok((info, ambient))
+        Ok(io::read_grid_info(&self.file)?)
     }
 
+    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Grid, DistributedError> {
+        Ok(io::read_grid_box(&self.file, lo, hi)?)
+    }
+}
+
+/// The box of a grid one rank holds, raw samples x fastest: enough for a
+/// run when it covers the rank's brick and ghost layers
+/// ([`first_brick_box`](super::first_brick_box)).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Piece {
+    /// The whole grid's header.
+    pub info: GridInfo,
+    /// The piece's first sample, in the whole grid's indices.
+    pub lo: [usize; 3],
+    /// Samples per axis of the piece.
+    pub dims: [usize; 3],
+    /// The piece's samples, x fastest.
+    pub samples: Vec<f32>,
+    /// The whole grid's sample `(0, 0, 0)` (the ambient medium), which
+    /// this piece need not hold.
+    pub first: f32,
+}
+
+impl BrickSource for Piece {
+    fn info(&self) -> Result<GridInfo, DistributedError> {
+        Ok(self.info)
+    }
+
+    fn read(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Grid, DistributedError> {
+        let inside = (0..3)
+            .all(|a| self.lo[a] <= lo[a] && lo[a] < hi[a] && hi[a] <= self.lo[a] + self.dims[a]);
+        let count = self.dims.iter().product::<usize>();
+        if !inside || self.samples.len() != count {
+            return Err(DistributedError::Piece { lo, hi, held: (self.lo, self.dims) });
+        }
+        let d = [0, 1, 2].map(|a| hi[a] - lo[a]);
+        let mut out = Vec::with_capacity(d.iter().product());
+        for k in lo[2]..hi[2] {
+            for j in lo[1]..hi[1] {
+                let row = (k - self.lo[2]) * self.dims[1] + (j - self.lo[1]);
+                let start = row * self.dims[0] + (lo[0] - self.lo[0]);
+                out.extend_from_slice(&self.samples[start..start + d[0]]);
+            }
+        }
+        let origin = self.info.origin
+            + DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64) * self.info.spacing;
+        Ok(Grid::new(d, origin, self.info.spacing, out)?)
+    }
+
+    fn first(&self) -> Result<f32, DistributedError> {
+        Ok(self.first)
+    }
+}
+
+impl VolumeJob {
     /// Step as `TraceParams::for_grid` takes it: leapfrog at one cell.
     pub(crate) fn params(info: &GridInfo) -> TraceParams {
         let cell = info.spacing.min_element();
@@ -221,8 +315,16 @@ pub(crate) fn knife_range(bench: &SchlierenBench, results: &[TraceResult]) -> f6
 /// # Errors
 /// An unreadable volume, a failing trace.
 pub fn single(job: &VolumeJob) -> Result<Film, DistributedError> {
-    let (info, ambient) = job.header()?;
-    let whole = job.read_box([0; 3], info.dims)?;
+    single_from(job, job)
+}
+
+/// [`single`] of the samples `source` holds (the whole grid).
+///
+/// # Errors
+/// As [`single`].
+pub fn single_from(job: &VolumeJob, source: &dyn BrickSource) -> Result<Film, DistributedError> {
+    let (info, ambient) = job.header(source)?;
+    let whole = job.read_box(source, [0; 3], info.dims)?;
     let field = GridField::new(whole, job.interp, ambient)?;
     let bench = job.bench(&info, ambient, 1.0);
     let mut film = job.film(&bench)?;

@@ -45,8 +45,8 @@ mod rank;
 mod wire;
 
 pub use error::DistributedError;
-pub use job::{VolumeJob, VolumeOptics, VolumeRank, same, single};
-pub use rank::rank;
+pub use job::{BrickSource, Piece, VolumeJob, VolumeOptics, VolumeRank, same, single, single_from};
+pub use rank::{first_brick_box, rank, rank_from};
 pub use wire::{PHOTON_BYTES, RESULT_BYTES};
 
 /// Photons a rank advances per round, and most results it sends rank 0

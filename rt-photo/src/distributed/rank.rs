@@ -11,12 +11,12 @@ use rt_composite::{
     exchange::{Batch, ExchangeError, all_gather, rounds},
 };
 use rt_volume::{
-    Begin, BrickField, Bricks, Leg, PathState, TraceError, TraceParams, TraceResult, step_reach,
-    trace_begin, trace_leg,
+    Begin, BrickField, Bricks, GridInfo, Leg, PathState, TraceError, TraceParams, TraceResult,
+    step_reach, trace_begin, trace_leg,
 };
 
 use super::{
-    DistributedError, VolumeJob, VolumeOptics, VolumeRank,
+    BrickSource, DistributedError, VolumeJob, VolumeOptics, VolumeRank,
     job::{emissions, knife_range},
     wire::{Key, Words, key, put_count, put_photon, put_result, unkey},
 };
@@ -39,15 +39,16 @@ fn exchange_error<E: Into<DistributedError> + core::fmt::Display>(
 fn load_brick<C: Communicator>(
     comm: &C,
     job: &VolumeJob,
+    source: &dyn BrickSource,
     bricks: &Bricks,
     ambient: f64,
     params: &TraceParams,
 ) -> Result<BrickField, DistributedError> {
     let me = comm.rank();
-    let mut reach = step_reach(params, 2.0, 1.0)?;
+    let mut reach = step_reach(params, FIRST_N, FIRST_GRADIENT)?;
     loop {
         let (lo, hi) = bricks.samples_needed(me, reach, job.interp)?;
-        let samples = job.read_box(lo, hi)?;
+        let samples = job.read_box(source, lo, hi)?;
         let b = samples.index_bounds(job.interp);
         let mine: Vec<u8> = [b.n_max, b.grad_max].iter().flat_map(|v| v.to_le_bytes()).collect();
         let (all, _) = all_gather(comm, &mine).map_err(|e| exchange_error(me, e))?;
@@ -69,6 +70,30 @@ fn load_brick<C: Communicator>(
     }
 }
 
+/// The first read's bound on the index and its gradient (air-like media;
+/// a run reads again, with ghost layers to match, when any rank's samples
+/// exceed them).
+const FIRST_N: f64 = 2.0;
+const FIRST_GRADIENT: f64 = 1.0;
+
+/// The samples `rank` of `ranks` reads first (its brick and the ghost
+/// layers a step reaches in a medium within the first bounds), as
+/// `(lo, hi)` sample indices: the box a caller handing each rank its own
+/// [`super::Piece`] gives it (larger is fine).
+///
+/// # Errors
+/// A bad grid header, a grid that does not split for `ranks`.
+pub fn first_brick_box(
+    info: GridInfo,
+    interp: rt_volume::Interp,
+    ranks: usize,
+    rank: usize,
+) -> Result<([usize; 3], [usize; 3]), DistributedError> {
+    let bricks = Bricks::for_ranks(info, ranks)?;
+    let reach = step_reach(&VolumeJob::params(&info), FIRST_N, FIRST_GRADIENT)?;
+    Ok(bricks.samples_needed(rank, reach, interp)?)
+}
+
 /// What one rank does: trace its photons, hand the others on; rank 0
 /// returns the film, bit for bit the film of [`super::single`].
 ///
@@ -78,13 +103,26 @@ pub fn rank<C: Communicator>(
     comm: &C,
     job: &VolumeJob,
 ) -> Result<(Option<Film>, VolumeRank), DistributedError> {
+    rank_from(comm, job, job)
+}
+
+/// [`rank`] with this rank's samples from `source` (each rank its own:
+/// a [`super::Piece`] covering [`first_brick_box`]).
+///
+/// # Errors
+/// As [`rank`]; a piece that lacks samples a step reaches.
+pub fn rank_from<C: Communicator>(
+    comm: &C,
+    job: &VolumeJob,
+    source: &dyn BrickSource,
+) -> Result<(Option<Film>, VolumeRank), DistributedError> {
     let (me, ranks) = (comm.rank(), comm.size());
     let mut report = VolumeRank::default();
     let t = Instant::now();
-    let (info, ambient) = job.header()?;
+    let (info, ambient) = job.header(source)?;
     let bricks = Bricks::for_ranks(info, ranks)?;
     let params = VolumeJob::params(&info);
-    let field = load_brick(comm, job, &bricks, ambient, &params)?;
+    let field = load_brick(comm, job, source, &bricks, ambient, &params)?;
     report.brick_samples = field.stored_samples();
     report.grid_samples = info.dims.iter().product();
     report.seconds[0] = t.elapsed().as_secs_f64();
