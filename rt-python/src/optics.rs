@@ -319,14 +319,9 @@ pub(crate) fn bos<'py>(
     let v = &volume.inner;
     let (setup, images) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
         let setup = BosSetup::choose(v, &options)?;
-        // One `stop` question per ray: k² rays a pixel.
         let c = &setup.bos.camera;
         let rays = (c.width * c.height) as u64 * u64::from(setup.bos.aperture_samples).pow(2);
-        let images = setup.render_until(v, seed, &|| {
-            w.count_one(rays);
-            w.stopped()
-        })?;
-        w.progress(rays, rays);
+        let images = w.counting(rays, |stop| setup.render_until(v, seed, stop))?;
         Ok((setup, images))
     })?
     .map_err(setup_error)?;
@@ -409,14 +404,9 @@ pub(crate) fn focusing<'py>(
     let v = &volume.inner;
     let (setup, images) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
         let setup = FocusingSetup::choose(v, &options)?;
-        // One `stop` question per ray: k stripes of k rays a pixel.
         let c = &setup.system.camera;
         let rays = (c.width * c.height) as u64 * u64::from(setup.system.aperture_samples).pow(2);
-        let images = setup.render_until(v, seed, &|| {
-            w.count_one(rays);
-            w.stopped()
-        })?;
-        w.progress(rays, rays);
+        let images = w.counting(rays, |stop| setup.render_until(v, seed, stop))?;
         Ok((setup, images))
     })?
     .map_err(setup_error)?;

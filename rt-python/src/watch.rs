@@ -66,6 +66,22 @@ impl Watch {
         });
     }
 
+    /// Runs `render` with a `stop` that counts each question as one of
+    /// `total` units (`render_until` asks once a ray: width × height ×
+    /// k² for BOS and focusing), then reports the total.
+    pub(crate) fn counting<T>(
+        &self,
+        total: u64,
+        render: impl FnOnce(&(dyn Fn() -> bool + Sync)) -> T,
+    ) -> T {
+        let out = render(&|| {
+            self.count_one(total);
+            self.stopped()
+        });
+        self.progress(total, total);
+        out
+    }
+
     fn seen(&self) -> (u64, u64) {
         (self.done.load(Ordering::Relaxed), self.total.load(Ordering::Relaxed))
     }

@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _rtvis
 from ._checks import _array, _choice, _float, _integer, _number, _uint, _vector
-from ._composite import _Mpi4pyComm
+from ._composite import _Mpi4pyComm, _mpi_comm
 from ._volume import GLADSTONE_DALE_AIR, _INTERPOLATIONS, _QUANTITIES
 
 Box = Tuple[Tuple[int, int, int], Tuple[int, int, int]]
@@ -62,14 +62,7 @@ def schlieren_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int
     :func:`schlieren`'s. A piece short of its ghost layers raises
     ``ValueError`` naming the samples it lacks.
     """
-    try:
-        from mpi4py import MPI  # type: ignore[import-not-found, unused-ignore]
-    except ImportError as e:
-        raise ImportError("schlieren_pieces needs mpi4py") from e
-    if comm is None:
-        comm = MPI.COMM_WORLD
-    if not isinstance(comm, MPI.Comm):
-        raise TypeError(f"comm: expected an mpi4py communicator, got {type(comm).__name__}")
+    comm = _mpi_comm(comm, "schlieren_pieces")
     values = _array("piece", piece, 3, np.float32)
     z0, y0, x0 = (_integer(f"start[{i}]", v, 0, 1 << 31) for i, v in enumerate(start))
     z, y, x = _shape("shape", shape)

@@ -41,6 +41,21 @@ def composite(rgba_list: Sequence[ArrayLike], depth_list: Sequence[ArrayLike]
     return _rtvis._composite([p[0] for p in pairs], [p[1] for p in pairs])
 
 
+def _mpi_comm(comm: Any, what: str) -> Any:
+    """``comm``, an mpi4py communicator (default ``MPI.COMM_WORLD``), for
+    ``what``; ``ImportError`` without mpi4py, ``TypeError`` for another
+    kind of value."""
+    try:
+        from mpi4py import MPI  # type: ignore[import-not-found, unused-ignore]
+    except ImportError as e:
+        raise ImportError(f"{what} needs mpi4py (pip install mpi4py, or Debian's python3-mpi4py)") from e
+    if comm is None:
+        return MPI.COMM_WORLD
+    if not isinstance(comm, MPI.Comm):
+        raise TypeError(f"comm: expected an mpi4py communicator, got {type(comm).__name__}")
+    return comm
+
+
 class _Mpi4pyComm:
     """The transport rt-composite's schedule runs over: tagged byte
     messages on an ``mpi4py`` communicator (non-blocking sends, probed
@@ -104,14 +119,7 @@ def composite_mpi(rgba: ArrayLike, depth: ArrayLike, comm: Any = None, schedule:
     bit for bit. A rank that fails or stays silent for ``timeout`` seconds
     makes every rank raise ``ValueError`` instead of hanging.
     """
-    try:
-        from mpi4py import MPI  # type: ignore[import-not-found, unused-ignore]
-    except ImportError as e:
-        raise ImportError("composite_mpi needs mpi4py (pip install mpi4py, or Debian's python3-mpi4py)") from e
-    if comm is None:
-        comm = MPI.COMM_WORLD
-    if not isinstance(comm, MPI.Comm):
-        raise TypeError(f"comm: expected an mpi4py communicator, got {type(comm).__name__}")
+    comm = _mpi_comm(comm, "composite_mpi")
     c, d = _image_pair(0, rgba, depth)
     sched = _choice("schedule", schedule, ("binary-swap", "radix-k", "direct-send"))
     k = _integer("radix", radix, 2, 1 << 20)
