@@ -50,16 +50,6 @@ impl SchlierenBench {
             _ => self.render_with(&until(stop, |o, d| medium.trace(o, d, None)), film, pass, seed),
         }
     }
-
-    /// One pass through `medium` with every step integrated (no
-    /// skipping: a bench that cannot see deflections would skip them
-    /// all), as surveys need.
-    ///
-    /// # Errors
-    /// As [`SchlierenBench::render`].
-    pub(crate) fn probe_medium(&self, medium: &Medium, film: &mut Film) -> Result<(), BenchError> {
-        self.render_with(&|o, d| medium.trace(o, d, None), film, 0, 0x5eed)
-    }
 }
 
 impl Bos {

@@ -270,3 +270,60 @@ fn pieces_held_in_memory_equal_one_process_bit_for_bit() {
     });
     assert!(errors.iter().any(|e| e.contains("too few ghost layers")), "{errors:?}");
 }
+
+/// BOS and focusing schlieren of the blast wave, each rank holding only
+/// its piece: the rig chosen from a survey traced across the ranks, and
+/// every camera ray handed between bricks, give the images of one process
+/// tracing the whole grid, bit for bit, on 1 to 4 ranks.
+#[test]
+fn bos_and_focusing_across_ranks_equal_one_process_bit_for_bit() {
+    let dir = std::env::temp_dir().join(format!("rt-tools-test-cameras-{}", std::process::id()));
+    let job = volume::builtin(&dir, 32, 1).unwrap();
+    let info = rt_volume::io::read_grid_info(&job.file).unwrap();
+    let grid = rt_volume::io::read_grid_box(&job.file, [0; 3], info.dims).unwrap();
+    let piece = |ranks: usize, rank: usize| -> anyhow::Result<volume::Piece> {
+        let (lo, hi) = volume::first_brick_box(info, job.interp, ranks, rank)?;
+        let dims = [0, 1, 2].map(|a| hi[a] - lo[a]);
+        let mut samples = Vec::new();
+        for k in lo[2]..hi[2] {
+            for j in lo[1]..hi[1] {
+                let row = (k * info.dims[1] + j) * info.dims[0];
+                samples.extend_from_slice(&grid.data()[row + lo[0]..row + hi[0]]);
+            }
+        }
+        Ok(volume::Piece { info, lo, dims, samples, first: grid.data()[0] })
+    };
+    let f64_bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let bos = rt_photo::BosOptions { size: 40, samples_per_axis: 1, ..Default::default() };
+    let (setup, whole) = volume::bos_single(&job, &job, &bos, 5).unwrap();
+    // The survey saw the blast: the background sits where its deflection
+    // moves the dots, and they move.
+    assert!(setup.rig.deflection > 0.0, "{}", setup.rig);
+    let moved = whole.displacement.iter().map(|d| d[0].hypot(d[1])).fold(0.0, f64::max);
+    assert!(moved > 0.1, "largest displacement {moved} px, rig {}", setup.rig);
+    let focusing =
+        rt_photo::FocusingOptions { size: 40, samples_per_axis: 2, ..Default::default() };
+    let (fsetup, fwhole) = volume::focusing_single(&job, &job, &focusing, 5).unwrap();
+    assert_ne!(f64_bits(&fwhole.flow), f64_bits(&fwhole.reference));
+    for ranks in [1usize, 2, 3, 4] {
+        let ((s, images), reports) =
+            on_ranks(ranks, |c| Ok(volume::bos_rank(c, &job, &piece(ranks, c.rank())?, &bos, 5)?));
+        assert_eq!(s.rig, setup.rig, "{ranks} ranks: another rig");
+        assert_eq!(f64_bits(&images.flow), f64_bits(&whole.flow), "{ranks} ranks: BOS flow");
+        let d = |i: &rt_photo::BosImages| {
+            i.displacement.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>()
+        };
+        assert_eq!(d(&images), d(&whole), "{ranks} ranks: displacement");
+        if ranks == 4 {
+            assert!(reports.iter().map(|r| r.handed_off).sum::<u64>() > 100);
+            assert!(reports.iter().all(|r| r.brick_samples < r.grid_samples));
+        }
+        let ((s, images), _) = on_ranks(ranks, |c| {
+            Ok(volume::focusing_rank(c, &job, &piece(ranks, c.rank())?, &focusing, 5)?)
+        });
+        assert_eq!(s.rig, fsetup.rig, "{ranks} ranks: another focusing rig");
+        assert_eq!(f64_bits(&images.flow), f64_bits(&fwhole.flow), "{ranks} ranks: focusing");
+        assert_eq!(f64_bits(&images.reference), f64_bits(&fwhole.reference));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use glam::DVec3;
 use rt_volume::{BrickError, GridError, MediumError, TraceError, io::ReadError};
 
-use crate::{BenchError, FilmError};
+use crate::{BenchError, FilmError, SetupError};
 
 /// Why a distributed volume render failed on this rank (every rank learns
 /// of a failure within the communicator's timeout).
@@ -39,6 +39,8 @@ pub enum DistributedError {
     Bench(BenchError),
     /// The film could not be made.
     Film(FilmError),
+    /// A BOS or focusing set-up is bad, or its render failed.
+    Setup(SetupError),
     /// More photons than one distributed run traces (each rank lists
     /// their identities once).
     TooManyPhotons {
@@ -92,6 +94,7 @@ impl fmt::Display for DistributedError {
             ),
             Self::Bench(e) => e.fmt(f),
             Self::Film(e) => e.fmt(f),
+            Self::Setup(e) => e.fmt(f),
             Self::TooManyPhotons { photons, max } => {
                 write!(f, "{photons} photons is more than a distributed run traces ({max})")
             }
@@ -116,6 +119,7 @@ impl core::error::Error for DistributedError {
             Self::Trace(e) => Some(e),
             Self::Bench(e) => Some(e),
             Self::Film(e) => Some(e),
+            Self::Setup(e) => Some(e),
             _ => None,
         }
     }
@@ -132,7 +136,7 @@ macro_rules! from {
 }
 
 from!(ReadError => Read, MediumError => Samples, GridError => Grid, BrickError => Brick,
-    TraceError => Trace, BenchError => Bench, FilmError => Film);
+    TraceError => Trace, BenchError => Bench, FilmError => Film, SetupError => Setup);
 
 impl From<core::convert::Infallible> for DistributedError {
     fn from(e: core::convert::Infallible) -> Self {

@@ -2,19 +2,19 @@
 //! whole (the reference every rank count must equal).
 
 use alloc::vec::Vec;
-use std::{path::PathBuf, sync::Mutex};
+use std::path::PathBuf;
 
 use glam::DVec3;
 use rayon::prelude::*;
 use rt_composite::exchange::ExchangeStats;
 use rt_volume::{
-    Exit, Grid, GridField, GridInfo, Interp, MediumError, Samples, TraceParams, TraceResult,
-    TraceStats, io, trace,
+    Grid, GridField, GridInfo, Interp, MediumError, Samples, TraceParams, TraceResult, io, trace,
 };
 
 use super::{
     BATCH, DistributedError, MAX_PHOTONS,
-    wire::{Key, PHOTON_BYTES, RESULT_BYTES, key, unkey},
+    across::emissions,
+    wire::{PHOTON_BYTES, RESULT_BYTES, unkey},
 };
 use crate::{Axis, Cutoff, Film, Filter, Mode, Reconstruction, SchlierenBench, Weighting};
 
@@ -266,40 +266,6 @@ pub struct VolumeRank {
     pub seconds: [f64; 3],
 }
 
-/// The photons the bench emits for `film`, each once, by key.
-pub(crate) fn emissions(
-    bench: &SchlierenBench,
-    film: &Film,
-    seed: u64,
-) -> Result<Vec<Key>, DistributedError> {
-    let seen = Mutex::new(Vec::new());
-    let mut scratch = Film::new(film.width(), film.height(), Filter::Tent)?;
-    bench.render_with(
-        &|o, d| {
-            seen.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push(key(o, d));
-            Ok(straight(o, d))
-        },
-        &mut scratch,
-        0,
-        seed,
-    )?;
-    let mut keys = seen.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner);
-    keys.sort_unstable();
-    keys.dedup();
-    Ok(keys)
-}
-
-/// A photon that went straight, nothing done.
-fn straight(o: DVec3, d: DVec3) -> TraceResult {
-    TraceResult {
-        position: o,
-        direction: d,
-        optical_path: 0.0,
-        exit: Exit::Missed,
-        stats: TraceStats::default(),
-    }
-}
-
 /// The knife edge's range from the photons' deflections along u: 0.5 ±
 /// 0.45 at their 99th percentile (f = 1 m).
 pub(crate) fn knife_range(bench: &SchlierenBench, results: &[TraceResult]) -> f64 {
@@ -329,7 +295,10 @@ pub fn single_from(job: &VolumeJob, source: &dyn BrickSource) -> Result<Film, Di
     let bench = job.bench(&info, ambient, 1.0);
     let mut film = job.film(&bench)?;
     let bench = if job.optics == VolumeOptics::Knife {
-        let keys = emissions(&bench, &film, job.seed)?;
+        let keys = emissions(|t| {
+            let mut scratch = Film::new(film.width(), film.height(), Filter::Tent)?;
+            Ok(bench.render_with(&t, &mut scratch, 0, job.seed)?)
+        })?;
         let results = keys
             .par_iter()
             .map(|k| {

@@ -4,9 +4,14 @@
 //! cross. Rank 0 lands them on the film in the bench's own order, so the
 //! image equals one process tracing the whole grid, bit for bit.
 //!
-//! 1. **Emission.** Every rank runs the bench once with a tracer that only
-//!    records what it is asked: the photons' `(origin, direction)`. A
-//!    photon's identity is those six `f64`s (its pixel and stratum are a
+//! The instrument is any that renders through a tracer: the schlieren
+//! bench ([`rank`]), background-oriented and focusing schlieren
+//! ([`bos_rank`], [`focusing_rank`], whose rig is chosen from a survey
+//! traced the same way).
+//!
+//! 1. **Emission.** Every rank runs the instrument once with a tracer that
+//!    only records what it is asked: the rays' `(origin, direction)`. A
+//!    ray's identity is those six `f64`s (its pixel and stratum are a
 //!    function of them). `rt_volume::trace_begin` carries each straight to
 //!    the volume; the rank owning its entry point keeps it (rank 0 also
 //!    keeps the ones that miss).
@@ -18,10 +23,10 @@
 //!    integrator carries (the bench draws no random numbers in flight);
 //!    one that leaves the volume becomes a result for rank 0. Rounds run
 //!    on `rt_composite::exchange::rounds` until no rank holds a photon.
-//! 3. **Film.** Rank 0 runs the bench again with a tracer that looks each
-//!    photon's result up by its identity: the landing, the cutoff and the
-//!    splatting happen in the bench's fixed order, exactly as in one
-//!    process.
+//! 3. **Film.** Rank 0 runs the instrument again with a tracer that looks
+//!    each ray's result up by its identity: the landing, the cutoff and
+//!    the splatting happen in the instrument's fixed order, exactly as in
+//!    one process.
 //!
 //! Each leg computes what the whole grid's trace computes (the brick
 //! interpolates with global indices, a step started in the owned box stays
@@ -39,11 +44,14 @@
 //! in `wire.rs`, beside `rt_volume::PathState`'s and `TraceResult`'s
 //! words.
 
+mod across;
+mod camera;
 mod error;
 mod job;
 mod rank;
 mod wire;
 
+pub use camera::{CameraRank, bos_rank, bos_single, focusing_rank, focusing_single};
 pub use error::DistributedError;
 pub use job::{BrickSource, Piece, VolumeJob, VolumeOptics, VolumeRank, same, single, single_from};
 pub use rank::{first_brick_box, rank, rank_from};

@@ -2,12 +2,12 @@
 //! chosen for the flow's deflections, a thin-lens camera and a
 //! background.
 
-use rt_volume::Medium;
+use rt_volume::{Bounds, Medium, TraceParams};
 
 use super::error::{positive, within};
 use crate::{
     Axis, Background, BackgroundChoice, Bos, BosImages, BosRig, BosRigOptions, DotBackground,
-    DotGrid, ImageBackground, SetupError, Survey, ThinLens,
+    DotGrid, ImageBackground, SchlierenBench, SetupError, Survey, ThinLens,
 };
 
 /// What a BOS recording is to be; `None` means "choose it from the
@@ -68,6 +68,25 @@ impl BosSetup {
     /// An option out of range, a camera inside its focal length of the
     /// volume, a bad background, a failing survey.
     pub fn choose(medium: &Medium, o: &BosOptions) -> Result<Self, SetupError> {
+        let params = medium.params();
+        Self::choose_with(medium.bounds(), params, o, |probe| {
+            Survey::of(medium, probe, Survey::WIDTH)
+        })
+    }
+
+    /// [`BosSetup::choose`] for a medium filling `bounds`, traced with
+    /// `params`, whose survey (asked only when the background distance is left to
+    /// choose) `survey` takes with the bench it is given (across ranks,
+    /// say: [`Survey::of_with`] with their tracer).
+    ///
+    /// # Errors
+    /// As [`BosSetup::choose`]; the survey's own.
+    pub fn choose_with<E: From<SetupError>>(
+        bounds: Bounds,
+        params: TraceParams,
+        o: &BosOptions,
+        survey: impl FnOnce(&SchlierenBench) -> Result<Survey, E>,
+    ) -> Result<Self, E> {
         within("size", o.size, 1, super::MAX_CAMERA_EDGE)?;
         within("samples", o.samples_per_axis, 1, super::MAX_APERTURE_SAMPLES)?;
         positive("f_number", o.f_number)?;
@@ -85,20 +104,21 @@ impl BosSetup {
         if let BackgroundChoice::Image { pixel: Some(px), .. } = &o.background {
             positive("background_pixel", *px)?;
         }
-        let b = medium.bounds();
+        let b = bounds;
         let (axis, u) = o.axis.frame();
         let v = axis.cross(u);
         let ext = b.max - b.min;
         let (w, h) = o.axis.image_size(b, o.size as usize);
         let deflection = if o.rig.background_distance.is_none() {
-            Survey::through(medium, o.axis, Survey::WIDTH)?.magnitude(0.99)
+            survey(&Survey::bench_through(b, o.axis, params))?.magnitude(0.99)
         } else {
             0.0
         };
-        let rig = BosRig::choose(&o.rig, ext.dot(u), ext.dot(axis), w, deflection)?;
+        let rig = BosRig::choose(&o.rig, ext.dot(u), ext.dot(axis), w, deflection)
+            .map_err(SetupError::from)?;
         let (f, z_a, z_d) = (rig.focal_length, rig.camera_distance, rig.background_distance);
         if z_a <= f {
-            return Err(SetupError::TooClose { distance: z_a, focal_length: f });
+            return Err(SetupError::TooClose { distance: z_a, focal_length: f }.into());
         }
         let camera = ThinLens {
             position: 0.5 * (b.min + b.max) + z_a * axis,
@@ -118,7 +138,9 @@ impl BosSetup {
             BackgroundChoice::Grid => DotGrid::for_camera(&camera, o.dot, o.spacing).into(),
             BackgroundChoice::Image { width, height, samples, pixel } => {
                 let px = pixel.unwrap_or(w as f64 / *width as f64);
-                ImageBackground::for_camera(&camera, *width, *height, samples.clone(), px)?.into()
+                ImageBackground::for_camera(&camera, *width, *height, samples.clone(), px)
+                    .map_err(SetupError::from)?
+                    .into()
             }
         };
         let bos = Bos {
@@ -126,9 +148,9 @@ impl BosSetup {
             background_distance: z_a + z_d,
             background,
             aperture_samples: o.samples_per_axis,
-            params: medium.params(),
+            params,
         };
-        bos.validate()?;
+        bos.validate().map_err(SetupError::from)?;
         Ok(Self { bos, rig })
     }
 

@@ -1,12 +1,12 @@
 //! Focusing schlieren set up from the data: a laboratory lens-and-grid
 //! rig, its grid pitch chosen for the flow's deflections.
 
-use rt_volume::Medium;
+use rt_volume::{Bounds, Medium, TraceParams};
 
 use super::error::{finite, invalid, positive, within};
 use crate::{
-    Axis, FocusingImages, FocusingRig, FocusingRigOptions, FocusingSchlieren, SetupError,
-    SourceGrid, Survey, ThinLens,
+    Axis, FocusingImages, FocusingRig, FocusingRigOptions, FocusingSchlieren, SchlierenBench,
+    SetupError, SourceGrid, Survey, ThinLens,
 };
 
 /// What a focusing-schlieren image is to be; `None` means "choose it from
@@ -69,15 +69,34 @@ impl FocusingSetup {
     /// # Errors
     /// An option out of range, a bad rig, a failing survey.
     pub fn choose(medium: &Medium, o: &FocusingOptions) -> Result<Self, SetupError> {
+        let params = medium.params();
+        Self::choose_with(medium.bounds(), params, o, |probe| {
+            Survey::of(medium, probe, Survey::WIDTH)
+        })
+    }
+
+    /// [`FocusingSetup::choose`] for a medium filling `bounds`, traced with
+    /// `params`, whose survey (asked only when the grid's pitch is left to
+    /// choose) `survey` takes with the bench it is given (across ranks,
+    /// say: [`Survey::of_with`] with their tracer).
+    ///
+    /// # Errors
+    /// As [`FocusingSetup::choose`]; the survey's own.
+    pub fn choose_with<E: From<SetupError>>(
+        bounds: Bounds,
+        params: TraceParams,
+        o: &FocusingOptions,
+        survey: impl FnOnce(&SchlierenBench) -> Result<Survey, E>,
+    ) -> Result<Self, E> {
         within("size", o.size, 1, super::MAX_CAMERA_EDGE)?;
         within("samples", o.samples_per_axis, 1, super::MAX_APERTURE_SAMPLES)?;
         finite("focus", o.focus)?;
         finite("angle", o.angle)?;
         if !(o.duty > 0.0 && o.duty < 1.0) {
-            return Err(invalid("duty", "in (0, 1)", o.duty));
+            return Err(invalid("duty", "in (0, 1)", o.duty).into());
         }
         if !(o.offset >= 0.0 && o.offset < 1.0) {
-            return Err(invalid("offset", "in [0, 1) pitches", o.offset));
+            return Err(invalid("offset", "in [0, 1) pitches", o.offset).into());
         }
         if let Some(n) = o.bands {
             within("bands", n, 1, u32::MAX)?;
@@ -93,18 +112,19 @@ impl FocusingSetup {
         ] {
             v.map(|v| positive(name, v)).transpose()?;
         }
-        let b = medium.bounds();
+        let b = bounds;
         let (axis, u) = o.axis.frame();
         let v = axis.cross(u);
         let ext = b.max - b.min;
         let (w, h) = o.axis.image_size(b, o.size as usize);
         let angle = o.angle.to_radians();
         let deflection = if o.rig.grid_pitch.is_none() {
-            Survey::through(medium, o.axis, Survey::WIDTH)?.along(angle, 0.99)
+            survey(&Survey::bench_through(b, o.axis, params))?.along(angle, 0.99)
         } else {
             0.0
         };
-        let rig = FocusingRig::choose(&o.rig, ext.dot(u), w, o.focus, o.offset, deflection)?;
+        let rig = FocusingRig::choose(&o.rig, ext.dot(u), w, o.focus, o.offset, deflection)
+            .map_err(SetupError::from)?;
         let camera = ThinLens {
             position: 0.5 * (b.min + b.max) + rig.camera_distance * axis,
             direction: -axis,
@@ -122,9 +142,9 @@ impl FocusingSetup {
             grid: SourceGrid { pitch: rig.grid_pitch, duty: o.duty, angle, bands: o.bands },
             cutoff_offset: o.offset,
             aperture_samples: o.samples_per_axis,
-            params: medium.params(),
+            params,
         };
-        system.validate()?;
+        system.validate().map_err(SetupError::from)?;
         Ok(Self { system, rig })
     }
 

@@ -3,7 +3,8 @@
 
 use alloc::vec::Vec;
 
-use rt_volume::Medium;
+use glam::DVec3;
+use rt_volume::{Bounds, Medium, TraceError, TraceParams, TraceResult};
 
 use crate::{Axis, Cutoff, Film, Filter, Mode, SchlierenBench, SetupError, math};
 
@@ -32,20 +33,40 @@ impl Survey {
     /// # Errors
     /// A failing trace.
     pub fn of(medium: &Medium, bench: &SchlierenBench, width: usize) -> Result<Self, SetupError> {
+        Self::of_with(bench, width, &|o, d| medium.trace(o, d, None))
+    }
+
+    /// [`Survey::of`] with any tracer `(origin, direction) → result` (the
+    /// photons of a grid spread over ranks, say).
+    ///
+    /// # Errors
+    /// A failing trace.
+    pub fn of_with(
+        bench: &SchlierenBench,
+        width: usize,
+        tracer: &(impl Fn(DVec3, DVec3) -> Result<TraceResult, TraceError> + Sync),
+    ) -> Result<Self, SetupError> {
         let width = width.max(1);
         let height = math::round(width as f64 * bench.height / bench.width).clamp(1.0, 4096.0);
         let mut film = Film::new(width, height as usize, Filter::Box)?;
-        let probe = SchlierenBench {
-            mode: Mode::Schlieren(Cutoff::None),
-            film_distance: 0.0,
-            ..bench.clone()
-        };
-        probe.probe_medium(medium, &mut film)?;
+        Self::probe(bench).render_with(tracer, &mut film, 0, 0x5eed)?;
         Ok(Self {
             eps: film.mean_deflection(),
             width,
             pixel: (bench.width / width as f64, bench.height / height),
         })
+    }
+
+    /// `bench` as the survey runs it: no cutoff, film in the image plane.
+    fn probe(bench: &SchlierenBench) -> SchlierenBench {
+        SchlierenBench { mode: Mode::Schlieren(Cutoff::None), film_distance: 0.0, ..bench.clone() }
+    }
+
+    /// The bench [`Survey::through`] looks along `axis` with, through
+    /// `bounds` with trace settings `params`.
+    #[must_use]
+    pub fn bench_through(bounds: Bounds, axis: Axis, params: TraceParams) -> SchlierenBench {
+        SchlierenBench::through(bounds, axis, Mode::Schlieren(Cutoff::None), 0.0, params)
     }
 
     /// The deflections seen looking through the whole of `medium` along
@@ -55,9 +76,7 @@ impl Survey {
     /// # Errors
     /// A failing trace.
     pub fn through(medium: &Medium, axis: Axis, width: usize) -> Result<Self, SetupError> {
-        let none = Mode::Schlieren(Cutoff::None);
-        let probe = SchlierenBench::through(medium.bounds(), axis, none, 0.0, medium.params());
-        Self::of(medium, &probe, width)
+        Self::of(medium, &Self::bench_through(medium.bounds(), axis, medium.params()), width)
     }
 
     /// The `q`-quantile of `|ε|`.
