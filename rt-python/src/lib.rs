@@ -38,6 +38,8 @@ fn _rtvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(composite::composite_comm, m)?)?;
     m.add_function(wrap_pyfunction!(bricks::brick_box, m)?)?;
     m.add_function(wrap_pyfunction!(bricks::schlieren_piece, m)?)?;
+    m.add_function(wrap_pyfunction!(bricks::bos_piece, m)?)?;
+    m.add_function(wrap_pyfunction!(bricks::focusing_piece, m)?)?;
     m.add("GLADSTONE_DALE_AIR", rt_volume::GLADSTONE_DALE_AIR)?;
     Ok(())
 }

@@ -248,7 +248,7 @@ pub(crate) fn record<'py>(
 /// `(reference [h, w], flow [h, w], displacement [h, w, 2] in pixels (x
 /// right, y down), a line describing the set-up, the rig chosen by
 /// `rtvis.bos`'s keywords)`.
-type BosOut<'py> = (
+pub(crate) type BosOut<'py> = (
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray3<f64>>,
@@ -283,6 +283,52 @@ pub(crate) fn bos<'py>(
     image_pixel: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<BosOut<'py>> {
+    let options = bos_options(
+        axis_name,
+        size,
+        focal_length,
+        f_number,
+        pixel,
+        distance,
+        background_distance,
+        dot,
+        spacing,
+        samples,
+        seed,
+        background,
+        image,
+        image_pixel,
+    )?;
+    let v = &volume.inner;
+    let (setup, images) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
+        let setup = BosSetup::choose(v, &options)?;
+        let c = &setup.bos.camera;
+        let rays = (c.width * c.height) as u64 * u64::from(setup.bos.aperture_samples).pow(2);
+        let images = w.counting(rays, |stop| setup.render_until(v, seed, stop))?;
+        Ok((setup, images))
+    })?
+    .map_err(setup_error)?;
+    bos_out(py, &setup, images)
+}
+
+/// The options `rtvis.bos`'s keywords give.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn bos_options(
+    axis_name: &str,
+    size: u32,
+    focal_length: Option<f64>,
+    f_number: f64,
+    pixel: Option<f64>,
+    distance: Option<f64>,
+    background_distance: Option<f64>,
+    dot: f64,
+    spacing: f64,
+    samples: u32,
+    seed: u64,
+    background: &str,
+    image: Option<PyReadonlyArray2<'_, f64>>,
+    image_pixel: Option<f64>,
+) -> PyResult<BosOptions> {
     let background = match (image, background) {
         (Some(i), _) => {
             let view = i.as_array();
@@ -300,7 +346,7 @@ pub(crate) fn bos<'py>(
                 rt_photo::PngError::Malformed { .. } => value_error(e),
             })?,
     };
-    let options = BosOptions {
+    Ok(BosOptions {
         axis: axis(axis_name)?,
         size,
         rig: BosRigOptions {
@@ -315,16 +361,15 @@ pub(crate) fn bos<'py>(
         spacing,
         samples_per_axis: samples,
         seed,
-    };
-    let v = &volume.inner;
-    let (setup, images) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
-        let setup = BosSetup::choose(v, &options)?;
-        let c = &setup.bos.camera;
-        let rays = (c.width * c.height) as u64 * u64::from(setup.bos.aperture_samples).pow(2);
-        let images = w.counting(rays, |stop| setup.render_until(v, seed, stop))?;
-        Ok((setup, images))
-    })?
-    .map_err(setup_error)?;
+    })
+}
+
+/// What `rtvis.bos` returns of `setup`'s `images`.
+pub(crate) fn bos_out<'py>(
+    py: Python<'py>,
+    setup: &BosSetup,
+    images: rt_photo::BosImages,
+) -> PyResult<BosOut<'py>> {
     let (bos, rig) = (&setup.bos, &setup.rig);
     let (w, h) = (images.width, images.height);
     let c = bos.camera;
@@ -350,7 +395,7 @@ pub(crate) fn bos<'py>(
 
 /// `(reference [h, w], flow [h, w], I/I₀ [h, w], a line describing the
 /// set-up, the rig chosen by `rtvis.focusing`'s keywords)`.
-type FocusingOut<'py> = (
+pub(crate) type FocusingOut<'py> = (
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
@@ -383,7 +428,53 @@ pub(crate) fn focusing<'py>(
     seed: u64,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<FocusingOut<'py>> {
-    let options = FocusingOptions {
+    let options = focusing_options(
+        axis_name,
+        size,
+        focal_length,
+        aperture,
+        pixel,
+        distance,
+        focus,
+        source_distance,
+        pitch,
+        duty,
+        angle,
+        offset,
+        bands,
+        samples,
+    )?;
+    let v = &volume.inner;
+    let (setup, images) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
+        let setup = FocusingSetup::choose(v, &options)?;
+        let c = &setup.system.camera;
+        let rays = (c.width * c.height) as u64 * u64::from(setup.system.aperture_samples).pow(2);
+        let images = w.counting(rays, |stop| setup.render_until(v, seed, stop))?;
+        Ok((setup, images))
+    })?
+    .map_err(setup_error)?;
+    focusing_out(py, &setup, images, angle)
+}
+
+/// The options `rtvis.focusing`'s keywords give.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn focusing_options(
+    axis_name: &str,
+    size: u32,
+    focal_length: Option<f64>,
+    aperture: Option<f64>,
+    pixel: Option<f64>,
+    distance: Option<f64>,
+    focus: f64,
+    source_distance: Option<f64>,
+    pitch: Option<f64>,
+    duty: f64,
+    angle: f64,
+    offset: f64,
+    bands: Option<u32>,
+    samples: u32,
+) -> PyResult<FocusingOptions> {
+    Ok(FocusingOptions {
         axis: axis(axis_name)?,
         size,
         rig: FocusingRigOptions {
@@ -400,16 +491,17 @@ pub(crate) fn focusing<'py>(
         offset,
         bands,
         samples_per_axis: samples,
-    };
-    let v = &volume.inner;
-    let (setup, images) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
-        let setup = FocusingSetup::choose(v, &options)?;
-        let c = &setup.system.camera;
-        let rays = (c.width * c.height) as u64 * u64::from(setup.system.aperture_samples).pow(2);
-        let images = w.counting(rays, |stop| setup.render_until(v, seed, stop))?;
-        Ok((setup, images))
-    })?
-    .map_err(setup_error)?;
+    })
+}
+
+/// What `rtvis.focusing` returns of `setup`'s `images` (`angle`: the
+/// bands' angle as the user gave it, degrees).
+pub(crate) fn focusing_out<'py>(
+    py: Python<'py>,
+    setup: &FocusingSetup,
+    images: rt_photo::FocusingImages,
+    angle: f64,
+) -> PyResult<FocusingOut<'py>> {
     let fs = &setup.system;
     let (w, h) = (images.width, images.height);
     let c = fs.camera;

@@ -46,8 +46,8 @@ PIECES = Path(__file__).with_name("mpi_pieces.py")
 
 @needs_mpi
 @pytest.mark.parametrize("n", [1, 2, 3, 4])
-@pytest.mark.parametrize("cutoff", ["knife", "interferometry"])
-def test_schlieren_of_pieces_equals_the_whole_grid_bit_for_bit(n, cutoff):
+@pytest.mark.parametrize("cutoff", ["knife", "interferometry", "bos", "focusing"])
+def test_pieces_give_the_whole_grids_image_bit_for_bit(n, cutoff):
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     r = subprocess.run([mpirun, "--oversubscribe", "-np", str(n), sys.executable, str(PIECES), cutoff],
                        capture_output=True, text=True, timeout=300, env=env)

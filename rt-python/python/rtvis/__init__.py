@@ -75,7 +75,7 @@ from ._surface import (
     _material,
     _paint_args,
 )
-from ._bricks import brick_box, schlieren_pieces
+from ._bricks import bos_pieces, brick_box, focusing_pieces, schlieren_pieces
 from ._composite import _ABANDONED_SENDS, _image_pair, _Mpi4pyComm, composite, composite_mpi
 from ._image import _srgb8, save_png, to_gray8, to_srgb8
 from ._watch import Optics, ProgressCallback
@@ -83,6 +83,7 @@ from ._watch import Optics, ProgressCallback
 __all__ = [
     "GLADSTONE_DALE_AIR",
     "bos",
+    "bos_pieces",
     "brick_box",
     "Camera",
     "Mesh",
@@ -100,6 +101,7 @@ __all__ = [
     "read_volume",
     "record",
     "schlieren",
+    "focusing_pieces",
     "schlieren_pieces",
     "save_png",
     "shadowgraph",

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from typing import Any, Dict, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -62,6 +62,24 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
     """
     if not isinstance(volume, (Volume, Mesh)):
         raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
+    args, fixed = _bos_args(axis, size, focal_length, f_number, pixel, distance, background_distance, dot,
+                            spacing, samples, seed, background, background_pixel)
+    *out, said, rig = _rtvis._bos(volume._v, *args, progress=_progress(progress, "rtvis.bos"))
+    return _bos_result(out, said, rig, fixed if chosen else None)
+
+
+# `_rtvis._bos`'s arguments after the volume.
+_BosArgs = Tuple[str, int, Optional[float], float, Optional[float], Optional[float], Optional[float], float, float,
+                 int, int, str, Optional[NDArray[np.float64]], Optional[float]]
+
+
+def _bos_args(axis: str = "z", size: int = 512, focal_length: Optional[float] = None, f_number: float = 16.0,
+              pixel: Optional[float] = None, distance: Optional[float] = None,
+              background_distance: Optional[float] = None, dot: float = 3.0, spacing: float = 4.0,
+              samples: int = 2, seed: int = 1, background: Union[str, os.PathLike[str], ArrayLike] = "random",
+              background_pixel: Optional[float] = None) -> Tuple[_BosArgs, Dict[str, Any]]:
+    """:func:`bos`'s keywords checked, as ``_rtvis._bos`` takes them after
+    the volume; and those an :class:`Optics` repeats as given."""
     image: Optional[NDArray[np.float64]] = None
     name = "random"
     if isinstance(background, (str, os.PathLike)):
@@ -73,8 +91,7 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
         if (image < 0).any():
             where = tuple(int(i) for i in np.argwhere(image < 0)[0])
             raise ValueError(f"background: value at {where} is negative ({image[where]})")
-    *out, said, rig = _rtvis._bos(
-        volume._v,
+    args: _BosArgs = (
         _str("axis", axis),
         _uint("size", size),
         _float("focal_length", focal_length, optional=True),
@@ -89,13 +106,19 @@ def bos(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, focal_len
         name,
         image,
         _float("background_pixel", background_pixel, optional=True),
-        _progress(progress, "rtvis.bos"),
     )
+    fixed: Dict[str, Any] = dict(axis=axis, size=size, f_number=f_number, dot=dot, spacing=spacing,
+                                 samples=samples, seed=seed)
+    if image is None:
+        fixed.update(background=background, background_pixel=background_pixel)
+    return args, fixed
+
+
+def _bos_result(out: List[Any], said: str, rig: Dict[str, Any],
+                fixed: Optional[Dict[str, Any]]) -> Tuple[Any, ...]:
+    """:func:`bos`'s tuple (with the :class:`Optics` when ``fixed`` is
+    given)."""
     result: Tuple[Any, ...] = (*out, said)
-    if chosen:
-        fixed: Dict[str, Any] = dict(axis=axis, size=size, f_number=f_number, dot=dot, spacing=spacing,
-                                     samples=samples, seed=seed)
-        if image is None:
-            fixed.update(background=background, background_pixel=background_pixel)
+    if fixed is not None:
         result += (Optics(said, **fixed, **rig),)
     return result

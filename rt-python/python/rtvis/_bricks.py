@@ -1,20 +1,28 @@
-"""Schlieren of a grid split over MPI ranks, each holding its own piece
-(as ParaView hands a rank its extent): photons are handed from brick to
-brick by rt's protocol over an mpi4py communicator."""
+"""Schlieren, BOS and focusing schlieren of a grid split over MPI ranks,
+each holding its own piece (as ParaView hands a rank its extent): photons
+are handed from brick to brick by rt's protocol over an mpi4py
+communicator."""
 
 from __future__ import annotations
 
-from typing import Any, Optional, Sequence, Tuple
+from typing import Any, Callable, Optional, Sequence, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _rtvis
 from ._checks import _array, _choice, _float, _integer, _number, _uint, _vector
+from ._bos import _bos_args, _bos_result
 from ._composite import _Mpi4pyComm, _mpi_comm
+from ._focusing import _focusing_args, _focusing_result
 from ._volume import GLADSTONE_DALE_AIR, _INTERPOLATIONS, _QUANTITIES
 
 Box = Tuple[Tuple[int, int, int], Tuple[int, int, int]]
+# What every `_rtvis._*_piece` takes first: the piece, its start and the
+# grid's dims (x, y, z), spacing, origin, first sample, quantity, k and
+# interpolation.
+_Held = Tuple[NDArray[np.float32], Tuple[int, int, int], Tuple[int, int, int], Tuple[float, float, float],
+              Tuple[float, float, float], float, str, float, str]
 
 
 def _shape(name: str, shape: Sequence[int]) -> Tuple[int, int, int]:
@@ -62,26 +70,86 @@ def schlieren_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int
     :func:`schlieren`'s. A piece short of its ghost layers raises
     ``ValueError`` naming the samples it lacks.
     """
-    comm = _mpi_comm(comm, "schlieren_pieces")
+    optics = _choice("cutoff", cutoff, ("knife", "interferometry"))
+    extra = (_float("wavelength", wavelength), _float("fringe_spacing", fringe_spacing, optional=True),
+             _uint("size", size), _integer("strata", strata, 1, 64), _uint("seed", seed, 64))
+    out: Optional[NDArray[np.float64]] = _on_ranks(
+        "schlieren_pieces", piece, start, shape, comm, spacing, origin, quantity, k, interpolation, timeout,
+        lambda held, transport: _rtvis._schlieren_piece(*(held + (optics,) + extra), comm=transport))
+    return out
+
+
+def bos_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int], comm: Any = None,
+               spacing: ArrayLike = (1.0, 1.0, 1.0), origin: ArrayLike = (0.0, 0.0, 0.0),
+               quantity: str = "density", k: float = GLADSTONE_DALE_AIR, interpolation: str = "cubic",
+               timeout: float = 60.0, chosen: bool = False, **options: Any) -> Optional[Tuple[Any, ...]]:
+    """:func:`bos` of a grid split over the ranks of ``comm`` as for
+    :func:`schlieren_pieces` (each rank its ``piece``): the survey that
+    chooses the rig and every camera ray are traced across the ranks, so
+    rank 0 gets :func:`bos`'s tuple (``chosen`` as there) and the others
+    ``None`` — bit for bit the images of one process holding the whole
+    grid, at any rank count. ``options`` are :func:`bos`'s keywords
+    (``axis``, ``size``, ``background``, …). Every ray is traced exactly
+    through the grid (no skipping of still air), so the images differ
+    slightly from :func:`bos` of a :class:`Volume`, which skips within a
+    tenth of a pixel."""
+    args, fixed = _bos_args(**options)
+    out = _on_ranks("bos_pieces", piece, start, shape, comm, spacing, origin, quantity, k, interpolation, timeout,
+                    lambda held, transport: _rtvis._bos_piece(*(held + args), comm=transport))
+    if out is None:
+        return None
+    *images, said, rig = out
+    return _bos_result(images, said, rig, fixed if chosen else None)
+
+
+def focusing_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int], comm: Any = None,
+                    spacing: ArrayLike = (1.0, 1.0, 1.0), origin: ArrayLike = (0.0, 0.0, 0.0),
+                    quantity: str = "density", k: float = GLADSTONE_DALE_AIR, interpolation: str = "cubic",
+                    timeout: float = 60.0, chosen: bool = False, **options: Any) -> Optional[Tuple[Any, ...]]:
+    """:func:`focusing` of a grid split over the ranks of ``comm`` as for
+    :func:`schlieren_pieces` (each rank its ``piece``): the survey that
+    chooses the grid's pitch and every camera ray are traced across the
+    ranks, so rank 0 gets :func:`focusing`'s tuple (``chosen`` as there)
+    and the others ``None`` — bit for bit the images of one process
+    holding the whole grid, at any rank count. ``options`` are
+    :func:`focusing`'s keywords. Every ray is traced exactly through the
+    grid (no skipping of still air), so the images differ slightly from
+    :func:`focusing` of a :class:`Volume`."""
+    args, fixed = _focusing_args(**options)
+    out = _on_ranks("focusing_pieces", piece, start, shape, comm, spacing, origin, quantity, k, interpolation,
+                    timeout, lambda held, transport: _rtvis._focusing_piece(*(held + args), comm=transport))
+    if out is None:
+        return None
+    *images, said, rig = out
+    return _focusing_result(images, said, rig, fixed if chosen else None)
+
+
+def _on_ranks(name: str, piece: ArrayLike, start: Sequence[int], shape: Sequence[int], comm: Any,
+              spacing: ArrayLike, origin: ArrayLike, quantity: str, k: float, interpolation: str, timeout: float,
+              run: Callable[[_Held, _Mpi4pyComm], Any]) -> Any:
+    """``run(held, transport)`` on every rank of ``comm``: ``held`` is the
+    piece and the grid as ``_rtvis``'s ``_*_piece`` functions take them
+    first, ``transport`` the communicator they trade over."""
+    comm = _mpi_comm(comm, name)
     values = _array("piece", piece, 3, np.float32)
+    if len(start) != 3:
+        raise ValueError(f"start: expected (z, y, x), got {tuple(start)}")
     z0, y0, x0 = (_integer(f"start[{i}]", v, 0, 1 << 31) for i, v in enumerate(start))
     z, y, x = _shape("shape", shape)
-    optics = _choice("cutoff", cutoff, ("knife", "interferometry"))
+    space = (_vector("spacing", spacing), _vector("origin", origin))
+    grid = (_choice("quantity", quantity, _QUANTITIES), _number("k", k, positive=True),
+            _choice("interpolation", interpolation, _INTERPOLATIONS))
     # The whole grid's first sample (the medium around it): from the rank
     # that holds it.
-    held = float(values[0, 0, 0]) if (z0, y0, x0) == (0, 0, 0) else None
-    firsts = [v for v in comm.allgather(held) if v is not None]
+    mine = float(values[0, 0, 0]) if (z0, y0, x0) == (0, 0, 0) else None
+    firsts = [v for v in comm.allgather(mine) if v is not None]
     if not firsts:
         raise ValueError("no rank holds sample (0, 0, 0) of the grid (the ambient medium)")
     transport = _Mpi4pyComm(comm, _number("timeout", timeout, positive=True))
     ok = False
     try:
-        out: Optional[NDArray[np.float64]] = _rtvis._schlieren_piece(
-            values, (x0, y0, z0), (x, y, z), _vector("spacing", spacing), _vector("origin", origin),
-            float(firsts[0]), _choice("quantity", quantity, _QUANTITIES), _number("k", k, positive=True),
-            _choice("interpolation", interpolation, _INTERPOLATIONS), optics, _float("wavelength", wavelength),
-            _float("fringe_spacing", fringe_spacing, optional=True), _uint("size", size),
-            _integer("strata", strata, 1, 64), _uint("seed", seed, 64), transport)
+        held: _Held = (values, (x0, y0, z0), (x, y, z), *space, float(firsts[0]), *grid)
+        out = run(held, transport)
         ok = True
         return out
     finally:

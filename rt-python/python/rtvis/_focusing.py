@@ -3,7 +3,7 @@ sets it up."""
 
 from __future__ import annotations
 
-from typing import Any, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -92,8 +92,27 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
     """
     if not isinstance(volume, (Volume, Mesh)):
         raise TypeError(f"volume: expected an rtvis.Volume or rtvis.Mesh, got {type(volume).__name__}")
-    *out, said, rig = _rtvis._focusing(
-        volume._v,
+    args, fixed = _focusing_args(axis, size, focal_length, aperture, pixel, distance, focus, source_distance,
+                                 pitch, duty, angle, offset, bands, samples, seed)
+    *out, said, rig = _rtvis._focusing(volume._v, *args, progress=_progress(progress, "rtvis.focusing"))
+    return _focusing_result(out, said, rig, fixed if chosen else None)
+
+
+# `_rtvis._focusing`'s arguments after the volume.
+_FocusingArgs = Tuple[str, int, Optional[float], Optional[float], Optional[float], Optional[float], float,
+                      Optional[float], Optional[float], float, float, float, Optional[int], int, int]
+
+
+def _focusing_args(axis: str = "z", size: int = 512, focal_length: Optional[float] = None,
+                   aperture: Optional[float] = None, pixel: Optional[float] = None,
+                   distance: Optional[float] = None, focus: float = 0.0, source_distance: Optional[float] = None,
+                   pitch: Optional[float] = None, duty: float = 0.5, angle: float = 0.0, offset: float = 0.25,
+                   bands: Optional[int] = None, samples: int = 6,
+                   seed: int = 1) -> Tuple[_FocusingArgs, Dict[str, Any]]:
+    """:func:`focusing`'s keywords checked, as ``_rtvis._focusing`` takes
+    them after the volume; and those an :class:`Optics` repeats as
+    given."""
+    args: _FocusingArgs = (
         _str("axis", axis),
         _uint("size", size),
         _float("focal_length", focal_length, optional=True),
@@ -109,11 +128,17 @@ def focusing(volume: Union[Volume, Mesh], axis: str = "z", size: int = 512, foca
         None if bands is None else _uint("bands", bands),
         _uint("samples", samples),
         _uint("seed", seed, 64),
-        _progress(progress, "rtvis.focusing"),
     )
+    fixed: Dict[str, Any] = dict(axis=axis, size=size, focus=focus, duty=duty, angle=angle, offset=offset,
+                                 bands=bands, samples=samples, seed=seed)
+    return args, fixed
+
+
+def _focusing_result(out: List[Any], said: str, rig: Dict[str, Any],
+                     fixed: Optional[Dict[str, Any]]) -> Tuple[Any, ...]:
+    """:func:`focusing`'s tuple (with the :class:`Optics` when ``fixed``
+    is given)."""
     result: Tuple[Any, ...] = (*out, said)
-    if chosen:
-        fixed = dict(axis=axis, size=size, focus=focus, duty=duty, angle=angle, offset=offset, bands=bands,
-                     samples=samples, seed=seed)
+    if fixed is not None:
         result += (Optics(said, **fixed, **rig),)
     return result
