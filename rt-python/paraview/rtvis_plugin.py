@@ -147,7 +147,7 @@ class _VolumeInput:
     ParaView reads a proxy's properties from the class's own dict."""
 
     _quantity, _k, _cubic, _nonphysical, _axis, _size, _seed = 0, 2.26e-4, 1, 0, 2, 512, 1
-    _lock, _locked, _chosen = 0, None, ""
+    _lock, _locked, _chosen, _across = 0, None, "", 1
 
     def _set(self, name, value):
         if getattr(self, name) != value:
@@ -241,20 +241,104 @@ class _VolumeInput:
         _image_output(out_info, w, h, px, o)
         return 1
 
+    @smproperty.intvector(name="AcrossRanks", default_values=[1])
+    @smdomain.xml('<BooleanDomain name="bool"/>')
+    @_doc("Under MPI (pvbatch, pvserver): each rank reads only its brick of the volume (point data) and the photons or camera rays are handed from rank to rank, so the image is the same on any number of ranks. Rays are traced exactly through the grid (no skipping of still air), so it differs slightly from one process's render. RT Schlieren does this for a knife edge at 0° with its height chosen, or interferometry, along z; its knife edge is then chosen from the photons' deflections, not from a survey. Off: rank 0 reads the whole volume.")
+    def SetAcrossRanks(self, v):
+        self._set("_across", int(v))
+
+    def _supports_pieces(self):
+        """Whether these optics can be rendered across ranks."""
+        return True
+
+    def _pieces(self):
+        """Whether this render hands rays across ranks (AcrossRanks)."""
+        # pvbatch and pvserver ranks, at any count; not pvpython or the
+        # GUI's built-in server (MPI-enabled too, but one process).
+        from paraview.modules.vtkRemotingCore import vtkProcessModule
+
+        kind = vtkProcessModule.GetProcessType()
+        ranks = (vtkProcessModule.PROCESS_BATCH, vtkProcessModule.PROCESS_SERVER,
+                 vtkProcessModule.PROCESS_DATA_SERVER)
+        ctrl = vtkMultiProcessController.GetGlobalController()
+        mpi = kind in ranks and ctrl is not None and ctrl.IsA("vtkMPIController")
+        cells = self.GetInputArrayInformation(0).Get(vtkDataObject.FIELD_ASSOCIATION()) == \
+            vtkDataObject.FIELD_ASSOCIATION_CELLS
+        return bool(self._across) and mpi and not cells and self._supports_pieces()
+
+    def _whole(self, in_info):
+        """The whole grid: (whole extent, shape (nz, ny, nx), spacing,
+        origin of its first sample)."""
+        info = in_info[0].GetInformationObject(0)
+        ext = info.Get(vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT())
+        spacing = tuple(float(v) for v in info.Get(vtkDataObject.SPACING()))
+        origin = tuple(o + h * e for o, h, e in zip(info.Get(vtkDataObject.ORIGIN()), spacing, ext[::2]))
+        shape = (ext[5] - ext[4] + 1, ext[3] - ext[2] + 1, ext[1] - ext[0] + 1)
+        return ext, shape, spacing, origin
+
     def RequestUpdateExtent(self, request, in_info, out_info):
-        # Rank 0 renders: it asks for the whole volume as one piece (a
-        # reader under MPI would otherwise hand it its piece only); the
-        # other ranks keep their own piece, unused, and output nothing,
-        # so N ranks take one rank's time instead of N renders contending
-        # for the cores.
-        rank, _ = _rank()
-        if rank == 0:
-            sddp = vtkStreamingDemandDrivenPipeline
-            info = in_info[0].GetInformationObject(0)
+        sddp = vtkStreamingDemandDrivenPipeline
+        info = in_info[0].GetInformationObject(0)
+        rank, size = _rank()
+        if self._pieces():
+            import rtvis
+
+            # This rank's brick and its ghost layers, as one piece.
+            ext, shape, spacing, origin = self._whole(in_info)
+            (z0, y0, x0), (z1, y1, x1) = rtvis.brick_box(shape, size, rank, spacing, origin,
+                                                         ["linear", "cubic"][self._cubic])
+            info.Set(sddp.UPDATE_PIECE_NUMBER(), 0)
+            info.Set(sddp.UPDATE_NUMBER_OF_PIECES(), 1)
+            info.Set(sddp.UPDATE_EXTENT(), ext[0] + x0, ext[0] + x1 - 1, ext[2] + y0, ext[2] + y1 - 1,
+                     ext[4] + z0, ext[4] + z1 - 1)
+        elif rank == 0:
+            # Rank 0 renders: it asks for the whole volume as one piece (a
+            # reader under MPI would otherwise hand it its piece only); the
+            # other ranks keep their own piece, unused, and output nothing,
+            # so N ranks take one rank's time instead of N renders
+            # contending for the cores.
             info.Set(sddp.UPDATE_PIECE_NUMBER(), 0)
             info.Set(sddp.UPDATE_NUMBER_OF_PIECES(), 1)
             info.Set(sddp.UPDATE_EXTENT(), info.Get(sddp.WHOLE_EXTENT()), 6)
         return 1
+
+    def _piece(self, in_info, label):
+        """This rank's piece of the chosen array, ``[z, y, x]``; its first
+        sample's index in the whole grid ``(z, y, x)``; the whole grid's
+        shape, spacing and origin."""
+        ext, shape, spacing, origin = self._whole(in_info)
+        data = vtkImageData.GetData(in_info[0], 0)
+        array = _selected_array(self, data)
+        if array is None:
+            raise ValueError(f"{label}: choose a scalar array (Array)")
+        e = data.GetExtent()
+        piece = numpy_support.vtk_to_numpy(array).reshape(e[5] - e[4] + 1, e[3] - e[2] + 1, e[1] - e[0] + 1)
+        start = (e[4] - ext[4], e[2] - ext[2], e[0] - ext[0])
+        return piece, start, shape, spacing, origin
+
+    def _render_pieces(self, run, options, in_info, out_info, label):
+        """``run`` (an ``rtvis.*_pieces`` function) of this rank's piece
+        with ``options`` (the locked optics, if any, on every rank alike);
+        rank 0 gets the images, the others ``None`` and an empty output."""
+        from mpi4py import MPI
+
+        comm = MPI.COMM_WORLD
+        piece, start, shape, spacing, origin = self._piece(in_info, label)
+        if self._lock and self._locked is not None:
+            options = {**options, **self._locked}
+        out = run(piece, start, shape, comm, spacing=spacing, origin=origin,
+                  quantity=["density", "index"][self._quantity], k=self._k,
+                  interpolation=["linear", "cubic"][self._cubic], chosen=True, **options)
+        # Rank 0's choice on every rank: a locked rig must be the same
+        # everywhere, or the ranks would ask for different rays.
+        chosen = comm.bcast(None if out is None else (dict(out[-1]), out[-1].description), root=0)
+        if self._lock and self._locked is None:
+            self._locked = chosen[0]
+        self._chosen = f"across {comm.Get_size()} ranks: {chosen[1]}"
+        if out is None:
+            vtkImageData.GetData(out_info).SetExtent(0, -1, 0, -1, 0, -1)
+            return None
+        return out[:-1]
 
     def _idle(self, out_info):
         """True on a rank other than 0, its output left empty (see
@@ -355,7 +439,7 @@ class RTSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
         VTKPythonAlgorithmBase.__init__(self, nInputPorts=1, nOutputPorts=1, outputType="vtkImageData")
         self._cutoff, self._angle = 0, 0.0
         self._f, self._h, self._film, self._wavelength, self._fringes = 1.0, 0.0, 0.0, 10.6e-6, 0.0
-        self._photons, self._across = 16, 1
+        self._photons = 16
 
     @_enum("Cutoff", "SetCutoff", ["Knife edge", "Graded filter", "Pinhole", "Dark field", "Colour (hue wheel)",
                                    "None (shadowgraph)", "Interferometry"], 0, "The optical set-up.")
@@ -400,70 +484,17 @@ class RTSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
     def SetPhotons(self, v):
         self._set("_photons", int(v))
 
-    @smproperty.intvector(name="AcrossRanks", default_values=[1])
-    @smdomain.xml('<BooleanDomain name="bool"/>')
-    @_doc("Under MPI (pvbatch, pvserver): each rank reads only its brick of the volume and photons are handed from rank to rank (knife edge at 0° with its height chosen, or interferometry; beam along z; point data). The knife edge is then chosen from the photons' deflections, not from a survey: the image is the same on any number of ranks, not the one process's of pvpython. Off: rank 0 reads the whole volume.")
-    def SetAcrossRanks(self, v):
-        self._set("_across", int(v))
-
-    def _pieces(self):
-        """Whether this render hands photons across ranks (AcrossRanks)."""
-        # pvbatch and pvserver ranks, at any count; not pvpython or the
-        # GUI's built-in server (MPI-enabled too, but one process).
-        from paraview.modules.vtkRemotingCore import vtkProcessModule
-
-        kind = vtkProcessModule.GetProcessType()
-        ranks = (vtkProcessModule.PROCESS_BATCH, vtkProcessModule.PROCESS_SERVER,
-                 vtkProcessModule.PROCESS_DATA_SERVER)
-        ctrl = vtkMultiProcessController.GetGlobalController()
-        mpi = kind in ranks and ctrl is not None and ctrl.IsA("vtkMPIController")
+    def _supports_pieces(self):
         knife = _CUTOFFS[self._cutoff] == "knife" and self._angle == 0.0 and self._h == 0.0 and self._film == 0.0
         fringes = _CUTOFFS[self._cutoff] == "interferometry" and self._film == 0.0
-        cells = self.GetInputArrayInformation(0).Get(vtkDataObject.FIELD_ASSOCIATION()) == \
-            vtkDataObject.FIELD_ASSOCIATION_CELLS
-        return bool(self._across) and mpi and self._axis == 2 and (knife or fringes) and not cells
-
-    def _whole(self, in_info):
-        """The whole grid: (whole extent, shape (nz, ny, nx), spacing,
-        origin of its first sample)."""
-        info = in_info[0].GetInformationObject(0)
-        ext = info.Get(vtkStreamingDemandDrivenPipeline.WHOLE_EXTENT())
-        spacing = tuple(float(v) for v in info.Get(vtkDataObject.SPACING()))
-        origin = tuple(o + h * e for o, h, e in zip(info.Get(vtkDataObject.ORIGIN()), spacing, ext[::2]))
-        shape = (ext[5] - ext[4] + 1, ext[3] - ext[2] + 1, ext[1] - ext[0] + 1)
-        return ext, shape, spacing, origin
-
-    def RequestUpdateExtent(self, request, in_info, out_info):
-        if not self._pieces():
-            return _VolumeInput.RequestUpdateExtent(self, request, in_info, out_info)
-        import rtvis
-
-        # This rank's brick and its ghost layers, as one piece.
-        ext, shape, spacing, origin = self._whole(in_info)
-        rank, size = _rank()
-        (z0, y0, x0), (z1, y1, x1) = rtvis.brick_box(shape, size, rank, spacing, origin,
-                                                     ["linear", "cubic"][self._cubic])
-        sddp = vtkStreamingDemandDrivenPipeline
-        info = in_info[0].GetInformationObject(0)
-        info.Set(sddp.UPDATE_PIECE_NUMBER(), 0)
-        info.Set(sddp.UPDATE_NUMBER_OF_PIECES(), 1)
-        info.Set(sddp.UPDATE_EXTENT(), ext[0] + x0, ext[0] + x1 - 1, ext[2] + y0, ext[2] + y1 - 1,
-                 ext[4] + z0, ext[4] + z1 - 1)
-        return 1
+        return self._axis == 2 and (knife or fringes)
 
     def _across_ranks(self, in_info, out_info):
         """The image with photons handed across ranks (``_pieces``)."""
         import rtvis
         from mpi4py import MPI
 
-        ext, shape, spacing, origin = self._whole(in_info)
-        data = vtkImageData.GetData(in_info[0], 0)
-        array = _selected_array(self, data)
-        if array is None:
-            raise ValueError("RT Schlieren: choose a scalar array (Array)")
-        e = data.GetExtent()
-        piece = numpy_support.vtk_to_numpy(array).reshape(e[5] - e[4] + 1, e[3] - e[2] + 1, e[1] - e[0] + 1)
-        start = (e[4] - ext[4], e[2] - ext[2], e[0] - ext[0])
+        piece, start, shape, spacing, origin = self._piece(in_info, "RT Schlieren")
         fringes = _CUTOFFS[self._cutoff] == "interferometry"
         image = rtvis.schlieren_pieces(
             piece, start, shape, MPI.COMM_WORLD, spacing=spacing, origin=origin,
@@ -578,15 +609,20 @@ class RTBOS(_VolumeInput, VTKPythonAlgorithmBase):
     def RequestData(self, request, in_info, out_info):
         import rtvis
 
-        if self._idle(out_info):
-            return 1
-        vol, image = self._volume(in_info, "RT BOS")
         options = dict(axis=_AXES[self._axis], size=self._size, seed=self._seed, f_number=self._fnumber,
                        focal_length=self._focal or None, pixel=self._pixel or None,
                        distance=self._distance or None, background_distance=self._zd or None, dot=self._dot,
                        spacing=self._spacing, samples=self._samples,
                        background=["random", "grid"][self._background])
-        out = self._render(rtvis.bos, vol, options)
+        if self._pieces():
+            *_, image = self._geometry(in_info)
+            options["dot_spacing"] = options.pop("spacing")  # bos_pieces's spacing is the grid's
+            out = self._render_pieces(rtvis.bos_pieces, options, in_info, out_info, "RT BOS")
+        elif self._idle(out_info):
+            return 1
+        else:
+            vol, image = self._volume(in_info, "RT BOS")
+            out = self._render(rtvis.bos, vol, options)
         if out is None:
             return 1
         reference, flow, disp, _ = out
@@ -663,14 +699,18 @@ class RTFocusingSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
     def RequestData(self, request, in_info, out_info):
         import rtvis
 
-        if self._idle(out_info):
-            return 1
-        vol, image = self._volume(in_info, "RT Focusing Schlieren")
         options = dict(axis=_AXES[self._axis], size=self._size, seed=self._seed, focus=self._focus,
                        aperture=self._aperture or None, focal_length=self._focal or None,
                        source_distance=self._source or None, pitch=self._pitch or None, duty=self._duty,
                        angle=self._angle, offset=self._offset, samples=self._samples)
-        out = self._render(rtvis.focusing, vol, options)
+        if self._pieces():
+            *_, image = self._geometry(in_info)
+            out = self._render_pieces(rtvis.focusing_pieces, options, in_info, out_info, "RT Focusing Schlieren")
+        elif self._idle(out_info):
+            return 1
+        else:
+            vol, image = self._volume(in_info, "RT Focusing Schlieren")
+            out = self._render(rtvis.focusing, vol, options)
         if out is None:
             return 1
         reference, flow, relative, _ = out

@@ -3,12 +3,12 @@
     mpirun -np N pvbatch --symmetric pvbatch_optics.py OUT_DIR
 
 Rank 0 writes a density bump as a .vti file; every rank reads it with
-ParaView's XML reader and applies RT Schlieren (each rank reading only
-its brick, photons handed across ranks), RT BOS and RT Focusing
-Schlieren (rank 0 reading the whole volume). Rank 0 writes
-OUT_DIR/optics-N.npz, which run-tests.sh compares, bit for bit, across
-N, checks RT Schlieren against one process holding the whole grid, and
-prints each filter's time."""
+ParaView's XML reader and applies RT Schlieren, RT BOS and RT Focusing
+Schlieren, each rank reading only its brick and the photons or camera
+rays handed across ranks. Rank 0 checks each image against one process
+holding the whole grid (bit for bit) and writes OUT_DIR/optics-N.npz,
+which run-tests.sh compares, bit for bit, across N; each filter's time
+is printed."""
 
 import os
 import sys
@@ -59,12 +59,11 @@ for name, (proxy, array) in filters.items():
     proxy.UpdatePipeline()
     comm.Barrier()
     took = time.perf_counter() - t
-    if name == "schlieren":
-        # RT Schlieren hands photons across ranks: each read its brick.
-        held = comm.gather(reader.GetClientSideObject().GetOutputDataObject(0).GetNumberOfPoints(), root=0)
-        if rank == 0:
-            print(f"schlieren on {n} ranks: each rank read {[f'{h / (56 * 48 * 40):.0%}' for h in held]} of the grid")
-            assert n == 1 or max(held) < 56 * 48 * 40, held
+    # Rays handed across ranks: each rank read its brick.
+    held = comm.gather(reader.GetClientSideObject().GetOutputDataObject(0).GetNumberOfPoints(), root=0)
+    if rank == 0:
+        print(f"{name} on {n} ranks: each rank read {[f'{h / (56 * 48 * 40):.0%}' for h in held]} of the grid")
+        assert n == 1 or max(held) < 56 * 48 * 40, held
     data = proxy.GetClientSideObject().GetOutputDataObject(0)
     values = data.GetPointData().GetArray(array)
     if rank == 0:
@@ -82,4 +81,15 @@ if rank == 0:
                                    spacing=(1e-3,) * 3, origin=(-0.028, -0.024, -0.020), size=256, strata=4, seed=1)
     shown = got["schlieren"].reshape(whole.shape)[::-1]  # VTK's rows go up
     assert np.array_equal(shown, whole), "RT Schlieren across ranks differs from one process"
-    print(f"schlieren on {n} ranks: equal to one process holding the whole grid")
+    grid = dict(spacing=(1e-3,) * 3, origin=(-0.028, -0.024, -0.020))
+    ref, flow, disp, _ = rtvis.bos_pieces(rho.astype(np.float32), (0, 0, 0), rho.shape, MPI.COMM_SELF, size=128,
+                                          **grid)
+    shown = got["bos"].reshape(disp.shape)[::-1]
+    assert np.array_equal(shown[..., 0], disp[..., 0]) and np.array_equal(shown[..., 1], -disp[..., 1]), \
+        "RT BOS across ranks differs from one process"
+    assert np.abs(disp).max() > 0.1, np.abs(disp).max()
+    *_, relative, _ = rtvis.focusing_pieces(rho.astype(np.float32), (0, 0, 0), rho.shape, MPI.COMM_SELF,
+                                            size=96, samples=3, **grid)
+    assert np.array_equal(got["focusing"].reshape(relative.shape)[::-1], relative), \
+        "RT Focusing Schlieren across ranks differs from one process"
+    print(f"schlieren, bos, focusing on {n} ranks: equal to one process holding the whole grid")

@@ -89,11 +89,15 @@ def bos_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int], com
     rank 0 gets :func:`bos`'s tuple (``chosen`` as there) and the others
     ``None`` — bit for bit the images of one process holding the whole
     grid, at any rank count. ``options`` are :func:`bos`'s keywords
-    (``axis``, ``size``, ``background``, …). Every ray is traced exactly
+    (``axis``, ``size``, ``background``, …), but the dots' spacing is
+    ``dot_spacing`` (``spacing`` is the grid's). Every ray is traced exactly
     through the grid (no skipping of still air), so the images differ
     slightly from :func:`bos` of a :class:`Volume`, which skips within a
     tenth of a pixel."""
+    if "dot_spacing" in options:
+        options["spacing"] = options.pop("dot_spacing")
     args, fixed = _bos_args(**options)
+    fixed["dot_spacing"] = fixed.pop("spacing")
     out = _on_ranks("bos_pieces", piece, start, shape, comm, spacing, origin, quantity, k, interpolation, timeout,
                     lambda held, transport: _rtvis._bos_piece(*(held + args), comm=transport))
     if out is None:
