@@ -53,3 +53,11 @@ def test_pieces_give_the_whole_grids_image_bit_for_bit(n, cutoff):
                        capture_output=True, text=True, timeout=300, env=env)
     assert r.returncode == 0, r.stdout + r.stderr
     assert f"{cutoff}: {n} ranks OK" in r.stdout, r.stdout + r.stderr
+
+
+@needs_mpi
+def test_bad_input_to_the_pieces_raises_clear_exceptions():
+    r = subprocess.run([sys.executable, str(Path(__file__).with_name("mpi_bad_pieces.py"))],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "bad pieces: 9 cases raise" in r.stdout

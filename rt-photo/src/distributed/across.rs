@@ -222,27 +222,25 @@ pub(crate) fn missing(e: TraceError) -> DistributedError {
 }
 
 /// The rays `emit` asks for, each once, by key; refused past
-/// [`MAX_PHOTONS`] (every rank lists them).
+/// [`MAX_PHOTONS`] (every rank lists them; the instrument is stopped at
+/// the first ray beyond).
 pub(crate) fn emissions(
     emit: impl FnOnce(&Tracer<'_>) -> Result<(), DistributedError>,
 ) -> Result<Vec<Key>, DistributedError> {
     let seen = Mutex::new(Vec::new());
-    let full = || DistributedError::TooManyPhotons {
-        photons: MAX_PHOTONS.saturating_add(1),
-        max: MAX_PHOTONS,
-    };
     let emitted = emit(&|o, d| {
         let mut seen = seen.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        if seen.len() as u64 >= MAX_PHOTONS {
-            // Ends the instrument's run; reported as too many below.
+        if seen.len() as u64 > MAX_PHOTONS {
+            // Ends the instrument's run: too many, reported below.
             return Err(TraceError::InvalidRay);
         }
         seen.push(key(o, d));
         Ok(straight(o, d))
     });
     let mut keys = seen.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner);
-    if keys.len() as u64 >= MAX_PHOTONS {
-        return Err(full());
+    if keys.len() as u64 > MAX_PHOTONS {
+        let photons = keys.len() as u64;
+        return Err(DistributedError::TooManyPhotons { photons, max: MAX_PHOTONS });
     }
     emitted?;
     keys.sort_unstable();

@@ -16,7 +16,7 @@ use rt_composite::Communicator;
 use rt_volume::{Bounds, GridField, TraceParams, trace};
 
 use super::{
-    BrickSource, DistributedError, VolumeJob, VolumeRank,
+    BrickSource, DistributedError, MAX_PHOTONS, VolumeJob, VolumeRank,
     across::{Across, Tracer, missing},
     wire::Words,
 };
@@ -97,6 +97,8 @@ fn bos_choose(
 
 fn bos_render(seed: u64) -> impl Fn(&BosSetup, &Tracer<'_>) -> Result<BosImages, DistributedError> {
     move |s, t| {
+        let c = &s.bos.camera;
+        at_most((c.width * c.height) as u64, s.bos.aperture_samples)?;
         s.bos.render_with(&t, seed).map_err(|e| match e {
             BosError::Trace(e) => missing(e),
             e => SetupError::Bos(e).into(),
@@ -115,11 +117,22 @@ fn focusing_render(
     seed: u64,
 ) -> impl Fn(&FocusingSetup, &Tracer<'_>) -> Result<FocusingImages, DistributedError> {
     move |s, t| {
+        let c = &s.system.camera;
+        at_most((c.width * c.height) as u64, s.system.aperture_samples)?;
         s.system.render_with(&t, seed).map_err(|e| match e {
             FocusingError::Trace(e) => missing(e),
             e => SetupError::Focusing(e).into(),
         })
     }
+}
+
+/// `Ok` if `pixels` with `k²` rays each are at most [`MAX_PHOTONS`].
+fn at_most(pixels: u64, k: u32) -> Result<(), DistributedError> {
+    let photons = pixels.saturating_mul(u64::from(k).pow(2));
+    if photons > MAX_PHOTONS {
+        return Err(DistributedError::TooManyPhotons { photons, max: MAX_PHOTONS });
+    }
+    Ok(())
 }
 
 /// The set-up `choose` makes (its survey across the ranks) and, on rank

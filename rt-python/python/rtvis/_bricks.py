@@ -5,7 +5,8 @@ communicator."""
 
 from __future__ import annotations
 
-from typing import Any, Callable, Optional, Sequence, Tuple
+import inspect
+from typing import Any, Callable, Dict, Optional, Sequence, Tuple, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -17,6 +18,7 @@ from ._composite import _Mpi4pyComm, _mpi_comm
 from ._focusing import _focusing_args, _focusing_result
 from ._volume import GLADSTONE_DALE_AIR, _INTERPOLATIONS, _QUANTITIES
 
+_T = TypeVar("_T")
 Box = Tuple[Tuple[int, int, int], Tuple[int, int, int]]
 # What every `_rtvis._*_piece` takes first: the piece, its start and the
 # grid's dims (x, y, z), spacing, origin, first sample, quantity, k and
@@ -96,7 +98,7 @@ def bos_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int], com
     tenth of a pixel."""
     if "dot_spacing" in options:
         options["spacing"] = options.pop("dot_spacing")
-    args, fixed = _bos_args(**options)
+    args, fixed = _options(_bos_args, "bos_pieces", options)
     fixed["dot_spacing"] = fixed.pop("spacing")
     out = _on_ranks("bos_pieces", piece, start, shape, comm, spacing, origin, quantity, k, interpolation, timeout,
                     lambda held, transport: _rtvis._bos_piece(*(held + args), comm=transport))
@@ -119,13 +121,23 @@ def focusing_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int]
     :func:`focusing`'s keywords. Every ray is traced exactly through the
     grid (no skipping of still air), so the images differ slightly from
     :func:`focusing` of a :class:`Volume`."""
-    args, fixed = _focusing_args(**options)
+    args, fixed = _options(_focusing_args, "focusing_pieces", options)
     out = _on_ranks("focusing_pieces", piece, start, shape, comm, spacing, origin, quantity, k, interpolation,
                     timeout, lambda held, transport: _rtvis._focusing_piece(*(held + args), comm=transport))
     if out is None:
         return None
     *images, said, rig = out
     return _focusing_result(images, said, rig, fixed if chosen else None)
+
+
+def _options(check: Callable[..., Tuple[_T, Dict[str, Any]]], name: str,
+             options: Dict[str, Any]) -> Tuple[_T, Dict[str, Any]]:
+    """``check(**options)``, an unknown keyword named as ``name``'s."""
+    known = inspect.signature(check).parameters
+    for key in options:
+        if key not in known:
+            raise TypeError(f"{name}() got an unexpected keyword argument {key!r}")
+    return check(**options)
 
 
 def _on_ranks(name: str, piece: ArrayLike, start: Sequence[int], shape: Sequence[int], comm: Any,
