@@ -203,17 +203,9 @@ fn bad_parameters_are_errors() {
             bench(Mode::Interferometry { lambda: -1.0, n_ref: 1.0, fringe_spacing: Some(1.0) }, 2),
             |e| e == BenchError::Wavelength(-1.0),
         ),
-        (
-            bench(
-                Mode::Schlieren(Cutoff::Color(rt_photo::FilterImage {
-                    size: 0,
-                    rgb: vec![],
-                    half_range: 1.0,
-                })),
-                2,
-            ),
-            |e| e == BenchError::Cutoff(CutoffError::EmptyImage),
-        ),
+        (bench(Mode::Schlieren(Cutoff::Color(rt_photo::FilterImage::opaque(0, 1.0))), 2), |e| {
+            e == BenchError::Cutoff(CutoffError::EmptyImage)
+        }),
         (bench(Mode::Schlieren(Cutoff::None), 0), |e| e == BenchError::Strata(0)),
         (
             SchlierenBench {

@@ -18,17 +18,23 @@ pub struct FilterImage {
     /// The deflection (radians) at the image's edges: pixel centres span
     /// `[−half_range, half_range]` on both axes.
     pub half_range: f64,
+    /// The filter is a disc of radius `half_range` (a hue wheel): light
+    /// deflected beyond it is blocked in every direction alike, not only
+    /// past the square table's edges (which a round flow would show as
+    /// four dark spots on the axes). `false`: the whole square transmits.
+    pub round: bool,
 }
 
 impl FilterImage {
     /// An all-black (opaque) filter to paint on.
     #[must_use]
     pub fn opaque(size: usize, half_range: f64) -> Self {
-        Self { size, rgb: alloc::vec![[0.0; 3]; size * size], half_range }
+        Self { size, rgb: alloc::vec![[0.0; 3]; size * size], half_range, round: false }
     }
 
     /// A hue wheel: colour by direction of `ε`, brightness by magnitude
-    /// (rainbow schlieren). `half_range` sets full saturation.
+    /// (rainbow schlieren). `half_range` sets full saturation, at the
+    /// rim of the disc that transmits ([`FilterImage::round`]).
     #[must_use]
     pub fn hue_wheel(size: usize, half_range: f64) -> Self {
         let mut f = Self::opaque(size, half_range);
@@ -43,6 +49,7 @@ impl FilterImage {
                     [(1.0 - k) + k * c(0.0), (1.0 - k) + k * c(2.094), (1.0 - k) + k * c(4.189)];
             }
         }
+        f.round = true;
         f
     }
 
@@ -64,12 +71,13 @@ impl FilterImage {
     }
 
     /// Transmission at deflection `(eu, ev)` (nearest pixel; outside the
-    /// image: opaque).
+    /// image, or a round filter's disc: opaque).
     #[must_use]
     pub fn at(&self, eu: f64, ev: f64) -> [f32; 3] {
         let to = |e: f64| math::floor((e / self.half_range + 1.0) * 0.5 * self.size as f64);
         let (i, j) = (to(eu), to(ev));
-        if i >= 0.0 && j >= 0.0 && (i as usize) < self.size && (j as usize) < self.size {
+        let inside = !self.round || eu * eu + ev * ev <= self.half_range * self.half_range;
+        if inside && i >= 0.0 && j >= 0.0 && (i as usize) < self.size && (j as usize) < self.size {
             self.rgb[i as usize + self.size * j as usize]
         } else {
             [0.0; 3]
@@ -377,7 +385,7 @@ mod tests {
             Err(CutoffError::NotFinite { param: CutoffParam::Angle, value }) if value.is_nan()
         ));
         assert_eq!(
-            Cutoff::Color(FilterImage { size: 0, rgb: alloc::vec![], half_range: 1.0 }).validate(),
+            Cutoff::Color(FilterImage::opaque(0, 1.0)).validate(),
             Err(CutoffError::EmptyImage)
         );
     }
@@ -401,7 +409,10 @@ mod tests {
         let pin = Cutoff::Pinhole { f: 1.0, radius: 0.0, dark_field: false };
         assert_eq!(pin.validate(), not_pos(P::Radius, 0.0));
         let img = |size, n, half_range| {
-            Cutoff::Color(FilterImage { size, rgb: alloc::vec![[0.5; 3]; n], half_range })
+            Cutoff::Color(FilterImage {
+                rgb: alloc::vec![[0.5; 3]; n],
+                ..FilterImage::opaque(size, half_range)
+            })
         };
         assert_eq!(img(2, 3, 1.0).validate(), Err(CutoffError::ImageSize { size: 2, len: 3 }));
         assert_eq!(img(2, 4, 0.0).validate(), not_pos(P::HalfRange, 0.0));
@@ -421,5 +432,25 @@ mod tests {
         assert_eq!(f.at(3e-4, -2e-4), [1.0, 0.0, 0.0]);
         assert_eq!(f.at(-3e-4, 2e-4), [0.0; 3]);
         assert_eq!(f.at(5e-3, 0.0), [0.0; 3]);
+    }
+
+    /// A hue wheel is round: just inside its rim it transmits the
+    /// saturated hue (`Σ rgb ≈ 1.5`), just outside nothing, on the axes
+    /// as on the diagonals (its table is square: past the rim on a
+    /// diagonal the table would still transmit).
+    #[test]
+    fn a_hue_wheel_is_round() {
+        let h = 1e-3;
+        let f = FilterImage::hue_wheel(256, h);
+        for a in [0.0f64, 0.5, 1.0, 1.5, 2.5, 3.5] {
+            let (s, c) = (a * core::f64::consts::FRAC_PI_4).sin_cos();
+            let sum: f32 = f.at(0.99 * h * c, 0.99 * h * s).iter().sum();
+            assert!((sum - 1.5).abs() < 0.05, "a = {a}: Σ {sum}");
+            assert_eq!(f.at(1.01 * h * c, 1.01 * h * s), [0.0; 3], "a = {a}");
+        }
+        // A painted slide transmits its whole square.
+        let mut slide = FilterImage::opaque(4, h);
+        slide.rgb = alloc::vec![[1.0; 3]; 16];
+        assert_eq!(slide.at(0.9 * h, 0.9 * h), [1.0; 3]);
     }
 }
