@@ -430,8 +430,8 @@ class RTSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
     """Synthetic schlieren, shadowgraph, interferogram or colour schlieren
     of a volume (density or refractive index) by rtvis: photons traced
     along curved paths through the field. Output: a 2-D image with
-    ``Intensity`` (1 = undisturbed background; ``RGB`` for the colour
-    filter; ``Fringes``, 0–1, and ``Phase``, radians unwrapped, for
+    ``Intensity`` (1 = undisturbed background; for the colour filter
+    ``RGB``, 8-bit sRGB for display, and ``LinearRGB``, float; ``Fringes``, 0–1, and ``Phase``, radians unwrapped, for
     interferometry) and ``Deflection`` (radians, along the image's axes),
     shown in grey as a photograph (see ``_display_defaults``)."""
 
@@ -535,8 +535,14 @@ class RTSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
         if out is None:
             return 1
         img, eps, *phase = out
-        name = "RGB" if img.ndim == 3 else "Fringes" if cutoff == "interferometry" else "Intensity"
-        arrays = [(name, img), ("Deflection", eps)]
+        if img.ndim == 3:
+            # 8-bit sRGB first: with Map Scalars unticked ParaView shows
+            # unsigned char colours as they are (float ones not at all).
+            opaque = np.concatenate([img, np.ones_like(img[..., :1])], axis=-1)
+            arrays = [("RGB", rtvis.to_srgb8(opaque)), ("LinearRGB", img)]
+        else:
+            arrays = [("Fringes" if cutoff == "interferometry" else "Intensity", img)]
+        arrays += [("Deflection", eps)]
         arrays += [("Phase", p) for p in phase]
         return self._image(out_info, image, arrays, "RT Schlieren")
 

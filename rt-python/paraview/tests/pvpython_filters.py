@@ -59,7 +59,11 @@ rtvis.save_png(os.path.join(out_dir, "paraview-schlieren.png"), rtvis.to_gray8(g
 print(f"RT Schlieren: {mine.shape[1]}×{mine.shape[0]}, equal to rtvis.schlieren; wrote paraview-schlieren.png")
 
 color = RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=4, Size=64)
-assert arrays(color)["RGB"].shape == (64, 64, 3)
+rgb = arrays(color)
+assert rgb["RGB"].shape == (64, 64, 3) and rgb["RGB"].dtype == np.uint8
+lin = rgb["LinearRGB"]
+assert np.array_equal(rgb["RGB"], rtvis.to_srgb8(np.dstack([lin, np.ones_like(lin[..., 0])])))
+assert rgb["RGB"].std() > 5, "the colour filter shows no colour"
 shadow = RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=5, Size=64)
 assert arrays(shadow)["Intensity"].std() > 0.01
 fringes = arrays(RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=6, Size=64, Wavelength=2e-4))

@@ -110,3 +110,40 @@ got = numpy_support.vtk_to_numpy(shot.GetPointData().GetScalars()).reshape(H, W,
 same = float((np.abs(got - traced).max(axis=2) <= 1).mean())
 print(f"the ray-traced pane: {same:.2%} of pixels as rtvis_view.raytrace")
 assert same > 0.99, same
+
+# The colour schlieren's RGB (8-bit sRGB) shown with Map Scalars
+# unticked: the render view draws its colours as they are.
+from paraview.simple import Hide, LoadPlugin  # noqa: E402
+
+LoadPlugin(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "rtvis_plugin.py"), ns=globals())
+bump = Calculator(Input=Wavelet(WholeExtent=[-24, 23, -24, 23, -24, 23]), ResultArrayName="density",
+                  Function="1.2 + 0.3*exp(-((coordsX*0.001)^2+(coordsY*0.001)^2+(coordsZ*0.001)^2)/(2*0.008^2))")
+colour = RTSchlieren(Input=bump, Array=["POINTS", "density"], Cutoff=4, Size=64)  # noqa: F821
+colour.UpdatePipeline()
+out = colour.GetClientSideObject().GetOutputDataObject(0)
+rgb = numpy_support.vtk_to_numpy(out.GetPointData().GetArray("RGB")).reshape(64, 64, 3)
+for d in (d1, d2, d3):
+    Hide(d.Input, view)
+shown = Show(colour, view)
+ColorBy(shown, ("POINTS", "RGB"))
+shown.MapScalars = 0
+b = out.GetBounds()
+view.CameraPosition = [(b[0] + b[1]) / 2, (b[2] + b[3]) / 2, 100.0]
+view.CameraFocalPoint = [(b[0] + b[1]) / 2, (b[2] + b[3]) / 2, 0.0]
+view.CameraViewUp = [0.0, 1.0, 0.0]
+view.CameraParallelProjection = 1
+view.CameraParallelScale = (b[3] - b[2] + out.GetSpacing()[1]) / 2  # the image fills the view's height
+view.ViewSize = [H, H]
+Render(view)
+colour_path = os.path.join(out_dir, "view-colour-schlieren.png")
+SaveScreenshot(colour_path, view, ImageResolution=[H, H])
+reader.SetFileName(colour_path)
+reader.Modified()
+reader.Update()
+shot = numpy_support.vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars()).reshape(H, H, -1)[..., :3]
+# Each image pixel's centre in the screenshot, against the array.
+centres = ((np.arange(64) + 0.5) * H / 64).astype(int)
+seen = shot[np.ix_(centres, centres)].astype(int)
+match = float((np.abs(seen - rgb.astype(int)).max(axis=2) <= 2).mean())
+print(f"the colour schlieren shown with Map Scalars off: {match:.1%} of its pixels in their own colour")
+assert match > 0.98, match
