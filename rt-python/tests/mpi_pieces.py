@@ -39,6 +39,8 @@ if cutoff in ("bos", "focusing"):
         # close, not equal).
         vol = rtvis.Volume(rho, quantity="density", **grid)
         rig = {k: v for k, v in out[-1].items() if k not in kw}
+        if "dot_spacing" in rig:  # bos_pieces's name for bos's spacing
+            rig["spacing"] = rig.pop("dot_spacing")
         own = (rtvis.bos if cutoff == "bos" else rtvis.focusing)(vol, **rig, **kw)
         signal = images[2] if cutoff == "bos" else images[2] - 1
         gap = float(np.abs(images[2] - own[2]).max()) / float(np.abs(signal).max())

@@ -92,7 +92,8 @@ def bos_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int], com
     ``None`` — bit for bit the images of one process holding the whole
     grid, at any rank count. ``options`` are :func:`bos`'s keywords
     (``axis``, ``size``, ``background``, …), but the dots' spacing is
-    ``dot_spacing`` (``spacing`` is the grid's). Every ray is traced exactly
+    ``dot_spacing`` (``spacing`` is the grid's; the :class:`Optics` says
+    ``dot_spacing`` too, so it repeats with this function). Every ray is traced exactly
     through the grid (no skipping of still air), so the images differ
     slightly from :func:`bos` of a :class:`Volume`, which skips within a
     tenth of a pixel."""
