@@ -219,6 +219,24 @@ fn a_rank_that_stops_answering_is_an_error_on_every_rank() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// Samples `lo..hi` of the whole `grid` as the piece a rank holds.
+fn cut(
+    grid: &rt_volume::Grid,
+    info: rt_volume::GridInfo,
+    lo: [usize; 3],
+    hi: [usize; 3],
+) -> volume::Piece {
+    let dims = [0, 1, 2].map(|a| hi[a] - lo[a]);
+    let mut samples = Vec::new();
+    for k in lo[2]..hi[2] {
+        for j in lo[1]..hi[1] {
+            let row = (k * info.dims[1] + j) * info.dims[0];
+            samples.extend_from_slice(&grid.data()[row + lo[0]..row + hi[0]]);
+        }
+    }
+    volume::Piece { info, lo, dims, samples, first: grid.data()[0] }
+}
+
 /// Each rank handed only its piece of the grid, as ParaView hands a rank
 /// its extent (here cut from the file in memory, each the box
 /// `first_brick_box` names): the same film as one process, bit for bit;
@@ -230,17 +248,7 @@ fn pieces_held_in_memory_equal_one_process_bit_for_bit() {
     let info = rt_volume::io::read_grid_info(&job.file).unwrap();
     let grid = rt_volume::io::read_grid_box(&job.file, [0; 3], info.dims).unwrap();
     let whole = volume::single(&job).unwrap();
-    let piece = |lo: [usize; 3], hi: [usize; 3]| {
-        let dims = [0, 1, 2].map(|a| hi[a] - lo[a]);
-        let mut samples = Vec::new();
-        for k in lo[2]..hi[2] {
-            for j in lo[1]..hi[1] {
-                let row = (k * info.dims[1] + j) * info.dims[0];
-                samples.extend_from_slice(&grid.data()[row + lo[0]..row + hi[0]]);
-            }
-        }
-        volume::Piece { info, lo, dims, samples, first: grid.data()[0] }
-    };
+    let piece = |lo, hi| cut(&grid, info, lo, hi);
     for ranks in [1usize, 2, 3, 4] {
         let (film, reports) = on_ranks(ranks, |c| {
             let (lo, hi) = volume::first_brick_box(info, job.interp, ranks, c.rank())?;
@@ -283,15 +291,7 @@ fn bos_and_focusing_across_ranks_equal_one_process_bit_for_bit() {
     let grid = rt_volume::io::read_grid_box(&job.file, [0; 3], info.dims).unwrap();
     let piece = |ranks: usize, rank: usize| -> anyhow::Result<volume::Piece> {
         let (lo, hi) = volume::first_brick_box(info, job.interp, ranks, rank)?;
-        let dims = [0, 1, 2].map(|a| hi[a] - lo[a]);
-        let mut samples = Vec::new();
-        for k in lo[2]..hi[2] {
-            for j in lo[1]..hi[1] {
-                let row = (k * info.dims[1] + j) * info.dims[0];
-                samples.extend_from_slice(&grid.data()[row + lo[0]..row + hi[0]]);
-            }
-        }
-        Ok(volume::Piece { info, lo, dims, samples, first: grid.data()[0] })
+        Ok(cut(&grid, info, lo, hi))
     };
     let f64_bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     let bos = rt_photo::BosOptions { size: 40, samples_per_axis: 1, ..Default::default() };

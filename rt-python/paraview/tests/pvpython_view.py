@@ -60,13 +60,21 @@ view.CameraFocalPoint = [0.0, 0.0, 0.0]
 view.CameraViewUp = [0.0, 1.0, 0.0]
 view.CameraViewAngle = 30.0
 
-raster_path = os.path.join(out_dir, "view-paraview.png")
-SaveScreenshot(raster_path, view, ImageResolution=[W, H])
-reader = vtkPNGReader()
-reader.SetFileName(raster_path)
-reader.Update()
-img = reader.GetOutput()
-raster = numpy_support.vtk_to_numpy(img.GetPointData().GetScalars()).reshape(H, W, -1)[::-1, :, :3].astype(int)
+
+
+def screenshot(shown, name, w, h):
+    """``shown``'s screenshot, written to OUT_DIR/``name`` and read back:
+    (h, w, 3) ints, row 0 at the bottom as VTK has it."""
+    path = os.path.join(out_dir, name)
+    SaveScreenshot(path, shown, ImageResolution=[w, h])
+    reader = vtkPNGReader()
+    reader.SetFileName(path)
+    reader.Update()
+    return numpy_support.vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars()).reshape(h, w, -1)[..., :3] \
+        .astype(int)
+
+
+raster = screenshot(view, "view-paraview.png", W, H)[::-1]
 
 rgba, depth = rtvis_view.raytrace(view, lights="flat")
 background = rtvis_view._linear(view.Background)
@@ -100,13 +108,7 @@ from paraview.simple import Render  # noqa: E402
 pane = rtvis_view.show(view, lights="flat")
 pane.ViewSize = [W, H]
 Render(pane)
-pane_path = os.path.join(out_dir, "view-pane.png")
-SaveScreenshot(pane_path, pane, ImageResolution=[W, H])
-reader.SetFileName(pane_path)
-reader.Modified()
-reader.Update()
-shot = reader.GetOutput()
-got = numpy_support.vtk_to_numpy(shot.GetPointData().GetScalars()).reshape(H, W, -1)[::-1, :, :3].astype(int)
+got = screenshot(pane, "view-pane.png", W, H)[::-1]
 same = float((np.abs(got - traced).max(axis=2) <= 1).mean())
 print(f"the ray-traced pane: {same:.2%} of pixels as rtvis_view.raytrace")
 assert same > 0.99, same
@@ -135,15 +137,10 @@ view.CameraParallelProjection = 1
 view.CameraParallelScale = (b[3] - b[2] + out.GetSpacing()[1]) / 2  # the image fills the view's height
 view.ViewSize = [H, H]
 Render(view)
-colour_path = os.path.join(out_dir, "view-colour-schlieren.png")
-SaveScreenshot(colour_path, view, ImageResolution=[H, H])
-reader.SetFileName(colour_path)
-reader.Modified()
-reader.Update()
-shot = numpy_support.vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars()).reshape(H, H, -1)[..., :3]
+shot = screenshot(view, "view-colour-schlieren.png", H, H)
 # Each image pixel's centre in the screenshot, against the array.
 centres = ((np.arange(64) + 0.5) * H / 64).astype(int)
-seen = shot[np.ix_(centres, centres)].astype(int)
+seen = shot[np.ix_(centres, centres)]
 match = float((np.abs(seen - rgb.astype(int)).max(axis=2) <= 2).mean())
 print(f"the colour schlieren shown with Map Scalars off: {match:.1%} of its pixels in their own colour")
 assert match > 0.98, match
