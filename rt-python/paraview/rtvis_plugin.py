@@ -21,6 +21,7 @@ other ranks' outputs are empty.
 
 import json
 import math
+import re
 
 import numpy as np
 from paraview.util.vtkAlgorithm import smdomain, smhint, smproperty, smproxy
@@ -326,9 +327,12 @@ class _VolumeInput:
         piece, start, shape, spacing, origin = self._piece(in_info, label)
         if self._lock and self._locked is not None:
             options = {**options, **self._locked}
-        out = run(piece, start, shape, comm, spacing=spacing, origin=origin,
-                  quantity=["density", "index"][self._quantity], k=self._k,
-                  interpolation=["linear", "cubic"][self._cubic], chosen=True, **options)
+        stopped, out = self._watched(run, piece, start, shape, comm, spacing=spacing, origin=origin,
+                                     quantity=["density", "index"][self._quantity], k=self._k,
+                                     interpolation=["linear", "cubic"][self._cubic], chosen=True, **options)
+        if stopped:
+            vtkImageData.GetData(out_info).SetExtent(0, -1, 0, -1, 0, -1)
+            return None
         # Rank 0's choice on every rank: a locked rig must be the same
         # everywhere, or the ranks would ask for different rays.
         chosen = comm.bcast(None if out is None else (dict(out[-1]), out[-1].description), root=0)
@@ -339,6 +343,21 @@ class _VolumeInput:
             vtkImageData.GetData(out_info).SetExtent(0, -1, 0, -1, 0, -1)
             return None
         return out[:-1]
+
+    def _watched(self, run, *args, **kwargs):
+        """``(stopped, run(*args, progress=…, **kwargs))`` across ranks:
+        rank 0 reports progress to ParaView and stops every rank on its
+        abort; stopped is True (and the result None) on rank 0 then, and
+        on the others, which hear only that rank 0 stopped (when it failed
+        instead, it says why itself)."""
+        try:
+            return False, run(*args, progress=self._progress, **kwargs)
+        except _Aborted:
+            return True, None
+        except ValueError as e:
+            if _rank()[0] != 0 and re.search(r"^rank \d+: rank 0 failed", str(e)):
+                return True, None
+            raise
 
     def _idle(self, out_info):
         """True on a rank other than 0, its output left empty (see
@@ -496,8 +515,8 @@ class RTSchlieren(_VolumeInput, VTKPythonAlgorithmBase):
 
         piece, start, shape, spacing, origin = self._piece(in_info, "RT Schlieren")
         fringes = _CUTOFFS[self._cutoff] == "interferometry"
-        image = rtvis.schlieren_pieces(
-            piece, start, shape, MPI.COMM_WORLD, spacing=spacing, origin=origin,
+        _, image = self._watched(
+            rtvis.schlieren_pieces, piece, start, shape, MPI.COMM_WORLD, spacing=spacing, origin=origin,
             quantity=["density", "index"][self._quantity], k=self._k, interpolation=["linear", "cubic"][self._cubic],
             cutoff="interferometry" if fringes else "knife", wavelength=self._wavelength,
             fringe_spacing=self._fringes or None, size=self._size,

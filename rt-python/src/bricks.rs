@@ -8,8 +8,8 @@ use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyReadonlyArray3, ndarray::
 use pyo3::prelude::*;
 use rt_photo::{
     distributed::{
-        DistributedError, Piece, VolumeJob, VolumeOptics, bos_rank, first_brick_box, focusing_rank,
-        rank_from,
+        DistributedError, Piece, VolumeJob, VolumeOptics, Watch, bos_rank, first_brick_box,
+        focusing_rank, rank_from,
     },
     glam::DVec3,
     rt_volume::GridInfo,
@@ -20,6 +20,7 @@ use crate::{
     optics::{BosOut, FocusingOut, bos_options, bos_out, focusing_options, focusing_out},
     value_error,
     volume::{interp, samples},
+    watch::watched,
 };
 
 /// The whole grid's header from Python's `(nx, ny, nz)`, spacing, origin.
@@ -87,18 +88,29 @@ impl Held {
     }
 }
 
-/// `run` on `comm`'s ranks with the GIL released; a failure as a
-/// `ValueError` naming the rank (and a peer's cause, if one is known).
+/// `run` on `comm`'s ranks, watched from this thread with the GIL
+/// released (`progress(done, total)` on rank 0; Ctrl-C or the callback's
+/// exception stops every rank); a failure as a `ValueError` naming the
+/// rank (and a peer's cause, if one is known).
 fn across<T: Send>(
     py: Python<'_>,
     comm: Py<PyAny>,
-    run: impl FnOnce(&PyComm) -> Result<T, DistributedError> + Send,
+    progress: Option<Py<PyAny>>,
+    run: impl FnOnce(&PyComm, Watch<'_>) -> Result<T, DistributedError> + Send,
 ) -> PyResult<T> {
     let c = PyComm::new(py, comm)?;
     let rank = c.rank_number();
-    py.detach(|| run(&c)).map_err(|e| {
+    let out = watched(py, progress, |w| {
+        let (stop, progress) = (|| w.stopped(), |d, t| w.progress(d, t));
+        run(&c, Watch::new(&stop, &progress))
+    })?;
+    out.map_err(|e| {
         let why = c.cause().map_or(String::new(), |c| format!(" ({c})"));
-        value_error(format!("rank {rank}: {e}{why}"))
+        // An exchange's error names this rank already.
+        let who = format!("rank {rank}: ");
+        let e = e.to_string();
+        let said = if e.starts_with(&who) { e } else { who + &e };
+        value_error(format!("{said}{why}"))
     })
 }
 
@@ -108,7 +120,7 @@ fn across<T: Send>(
 /// the undisturbed background `[h, w]`, the others `None`.
 #[pyfunction]
 #[pyo3(name = "_schlieren_piece")]
-#[pyo3(signature = (piece, lo, dims, spacing, origin, first, quantity, k, interpolation, optics, wavelength, fringe_spacing, size, strata, seed, comm))]
+#[pyo3(signature = (piece, lo, dims, spacing, origin, first, quantity, k, interpolation, optics, wavelength, fringe_spacing, size, strata, seed, comm, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn schlieren_piece<'py>(
     py: Python<'py>,
@@ -128,6 +140,7 @@ pub(crate) fn schlieren_piece<'py>(
     strata: u32,
     seed: u64,
     comm: Py<PyAny>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
     let optics = match optics {
         "knife" => VolumeOptics::Knife,
@@ -142,7 +155,7 @@ pub(crate) fn schlieren_piece<'py>(
     };
     let held = Held::new(&piece, lo, dims, spacing, origin, first, quantity, k, interpolation)?;
     let job = VolumeJob { optics, size, strata, seed, ..held.job };
-    let (film, _) = across(py, comm, |c| rank_from(c, &job, &held.piece))?;
+    let (film, _) = across(py, comm, progress, |c, w| rank_from(c, &job, &held.piece, w))?;
     let Some(film) = film else { return Ok(None) };
     // Relative to the undisturbed background: a knife edge passes half.
     let background = if matches!(job.optics, VolumeOptics::Knife) { 0.5 } else { 1.0 };
@@ -158,7 +171,7 @@ pub(crate) fn schlieren_piece<'py>(
 /// tuple, the others `None`.
 #[pyfunction]
 #[pyo3(name = "_bos_piece")]
-#[pyo3(signature = (piece, lo, dims, spacing, origin, first, quantity, k, interpolation, axis_name, size, focal_length, f_number, pixel, distance, background_distance, dot, spacing_dots, samples, seed, background, image, image_pixel, comm))]
+#[pyo3(signature = (piece, lo, dims, spacing, origin, first, quantity, k, interpolation, axis_name, size, focal_length, f_number, pixel, distance, background_distance, dot, spacing_dots, samples, seed, background, image, image_pixel, comm, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn bos_piece<'py>(
     py: Python<'py>,
@@ -186,6 +199,7 @@ pub(crate) fn bos_piece<'py>(
     image: Option<PyReadonlyArray2<'py, f64>>,
     image_pixel: Option<f64>,
     comm: Py<PyAny>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Option<BosOut<'py>>> {
     let options = bos_options(
         axis_name,
@@ -204,7 +218,8 @@ pub(crate) fn bos_piece<'py>(
         image_pixel,
     )?;
     let held = Held::new(&piece, lo, dims, spacing, origin, first, quantity, k, interpolation)?;
-    let (out, _) = across(py, comm, |c| bos_rank(c, &held.job, &held.piece, &options, seed))?;
+    let (out, _) =
+        across(py, comm, progress, |c, w| bos_rank(c, &held.job, &held.piece, &options, seed, w))?;
     out.map(|(setup, images)| bos_out(py, &setup, images)).transpose()
 }
 
@@ -215,7 +230,7 @@ pub(crate) fn bos_piece<'py>(
 /// `_focusing`'s tuple, the others `None`.
 #[pyfunction]
 #[pyo3(name = "_focusing_piece")]
-#[pyo3(signature = (piece, lo, dims, spacing, origin, first, quantity, k, interpolation, axis_name, size, focal_length, aperture, pixel, distance, focus, source_distance, pitch, duty, angle, offset, bands, samples, seed, comm))]
+#[pyo3(signature = (piece, lo, dims, spacing, origin, first, quantity, k, interpolation, axis_name, size, focal_length, aperture, pixel, distance, focus, source_distance, pitch, duty, angle, offset, bands, samples, seed, comm, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn focusing_piece<'py>(
     py: Python<'py>,
@@ -244,6 +259,7 @@ pub(crate) fn focusing_piece<'py>(
     samples: u32,
     seed: u64,
     comm: Py<PyAny>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Option<FocusingOut<'py>>> {
     let options = focusing_options(
         axis_name,
@@ -262,6 +278,8 @@ pub(crate) fn focusing_piece<'py>(
         samples,
     )?;
     let held = Held::new(&piece, lo, dims, spacing, origin, first, quantity, k, interpolation)?;
-    let (out, _) = across(py, comm, |c| focusing_rank(c, &held.job, &held.piece, &options, seed))?;
+    let (out, _) = across(py, comm, progress, |c, w| {
+        focusing_rank(c, &held.job, &held.piece, &options, seed, w)
+    })?;
     out.map(|(setup, images)| focusing_out(py, &setup, images, angle)).transpose()
 }

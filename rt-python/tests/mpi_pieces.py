@@ -17,6 +17,19 @@ z, y, x = (np.indices(shape) - (np.array(shape) / 2)[:, None, None, None]) * h
 rho = (1.2 + 0.4 * np.exp(-(x**2 + (y - 0.003) ** 2 + z**2) / (2 * 0.006**2))).astype(np.float32)
 grid = dict(spacing=(h, h, h), origin=(-0.022, -0.02, -0.018))
 cutoff = sys.argv[1]
+
+
+def check_progress(told, rays):
+    """Rank 0 alone is told its progress, rising to the total (``rays``
+    if known), the last call at the total."""
+    if rank != 0:
+        assert told == [], told
+        return
+    assert told, "no progress told"
+    total = told[-1][1]
+    assert told[-1] == (total, total) and (rays is None or total == rays), told[-3:]
+    assert all(a[0] <= b[0] and a[1] == b[1] for a, b in zip(told, told[1:])), told[:5]
+
 (z0, y0, x0), (z1, y1, x1) = rtvis.brick_box(shape, n, rank, **grid)
 piece = rho[z0:z1, y0:y1, x0:x1]
 held = piece.size / rho.size
@@ -28,7 +41,11 @@ if cutoff in ("bos", "focusing"):
     # between bricks.
     run = rtvis.bos_pieces if cutoff == "bos" else rtvis.focusing_pieces
     kw = dict(size=96, samples=2, seed=3)
-    out = run(piece, (z0, y0, x0), shape, comm, chosen=True, **grid, **kw)
+    told = []
+    out = run(piece, (z0, y0, x0), shape, comm, chosen=True, progress=lambda d, t: told.append((d, t)),
+              **grid, **kw)
+    # Counted in camera rays: samples² a pixel.
+    check_progress(told, out[0].shape[0] * out[0].shape[1] * 2 * 2 if rank == 0 else None)
     if rank == 0:
         whole = run(rho, (0, 0, 0), shape, MPI.COMM_SELF, chosen=True, **grid, **kw)
         images = [a for a in out if isinstance(a, np.ndarray)]
@@ -53,7 +70,9 @@ if cutoff in ("bos", "focusing"):
 kw = dict(grid, size=48, strata=2, seed=3)
 if cutoff == "interferometry":
     kw.update(cutoff="interferometry", wavelength=633e-9)
-image = rtvis.schlieren_pieces(piece, (z0, y0, x0), shape, comm, **kw)
+told = []
+image = rtvis.schlieren_pieces(piece, (z0, y0, x0), shape, comm, progress=lambda d, t: told.append((d, t)), **kw)
+check_progress(told, None)
 if rank == 0:
     whole = rtvis.schlieren_pieces(rho, (0, 0, 0), shape, MPI.COMM_SELF, **kw)
     assert image.shape == whole.shape and image.shape[1] == 48

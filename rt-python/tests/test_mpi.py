@@ -1,6 +1,7 @@
 """`composite_mpi` over real MPI processes (mpirun + mpi4py)."""
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -61,3 +62,27 @@ def test_bad_input_to_the_pieces_raises_clear_exceptions():
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "bad pieces: 9 cases raise" in r.stdout
+
+
+@needs_mpi
+@pytest.mark.parametrize("how", ["0", "1", "callback"])
+def test_ctrl_c_on_one_rank_stops_every_rank(how):
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    script = Path(__file__).with_name("mpi_interrupt.py")
+    r = subprocess.run([mpirun, "--oversubscribe", "-np", "2", sys.executable, str(script), how],
+                       capture_output=True, text=True, timeout=300, env=env)
+    assert r.returncode == 0, r.stdout + r.stderr
+    lines = re.findall(r"rank (\d): (.*) after ([\d.]+) s", r.stdout)
+    said = {int(k): (what, float(t)) for k, what, t in lines}
+    stopped = 0 if how == "callback" else int(how)
+    assert set(said) == {0, 1}, r.stdout + r.stderr
+    what, took = said[stopped]
+    assert what == ("Enough" if how == "callback" else "KeyboardInterrupt"), r.stdout
+    other, heard = said[1 - stopped]
+    assert other == f"ValueError: rank {1 - stopped}: rank {stopped} failed", r.stdout
+    # Uninterrupted, the render takes about ten seconds; SIGINT comes at
+    # 2 s, a poll (50 ms) and a photon's leg end it there; the peer hears
+    # within a round of the trade, long before the 60 s timeout.
+    if how != "callback":
+        assert took < 2.0 + 3.0, r.stdout
+    assert heard < took + 10.0, r.stdout

@@ -252,7 +252,7 @@ fn pieces_held_in_memory_equal_one_process_bit_for_bit() {
     for ranks in [1usize, 2, 3, 4] {
         let (film, reports) = on_ranks(ranks, |c| {
             let (lo, hi) = volume::first_brick_box(info, job.interp, ranks, c.rank())?;
-            Ok(volume::rank_from(c, &job, &piece(lo, hi))?)
+            Ok(volume::rank_from(c, &job, &piece(lo, hi), volume::Watch::NONE)?)
         });
         assert!(volume::same(&film, &whole), "{ranks} ranks: the films differ");
         if ranks > 1 {
@@ -270,13 +270,86 @@ fn pieces_held_in_memory_equal_one_process_bit_for_bit() {
                     let (lo, hi) = volume::first_brick_box(info, job.interp, 2, c.rank()).unwrap();
                     let lo = lo.map(|v| v + 1);
                     let hi = hi.map(|v| v - 1);
-                    volume::rank_from(&c, job, &piece(lo, hi)).err().map(|e| e.to_string())
+                    volume::rank_from(&c, job, &piece(lo, hi), volume::Watch::NONE)
+                        .err()
+                        .map(|e| e.to_string())
                 })
             })
             .collect();
         handles.into_iter().map(|h| h.join().unwrap().unwrap_or_default()).collect()
     });
     assert!(errors.iter().any(|e| e.contains("too few ghost layers")), "{errors:?}");
+}
+
+/// Each rank's outcome of `f` on `ranks` thread ranks, as text.
+fn outcomes<T: Send>(
+    ranks: usize,
+    f: impl Fn(&ThreadComm) -> Result<T, volume::DistributedError> + Sync,
+) -> Vec<Result<T, String>> {
+    let comms = ThreadComm::group(ranks, Duration::from_secs(60));
+    let f = &f;
+    std::thread::scope(|s| {
+        let handles: Vec<_> = comms.into_iter().map(|c| s.spawn(move || f(&c))).collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("rank panicked").map_err(|e| e.to_string()))
+            .collect()
+    })
+}
+
+/// A watched run: rank 0 alone is told its progress, rising to every
+/// photon; a rank told to stop (while it traces, or while it lists its
+/// photons) fails with `Stopped` and every peer learns of it from the
+/// exchange, none from the 60 s timeout.
+#[test]
+fn a_watched_run_tells_its_progress_and_stops_on_every_rank() {
+    use core::sync::atomic::{AtomicU64, Ordering};
+    use std::sync::Mutex;
+    let dir = std::env::temp_dir().join(format!("rt-tools-test-watch-{}", std::process::id()));
+    let job = volume::builtin(&dir, 32, 1).unwrap();
+    let told: Vec<Mutex<Vec<(u64, u64)>>> = (0..3).map(|_| Mutex::new(Vec::new())).collect();
+    let never = || false;
+    let out = outcomes(3, |c| {
+        let log = &told[c.rank()];
+        let progress = |d, t| log.lock().unwrap().push((d, t));
+        volume::rank_from(c, &job, &job, volume::Watch::new(&never, &progress))
+    });
+    let film = out[0].as_ref().unwrap().0.as_ref().unwrap();
+    assert!(volume::same(film, &volume::single(&job).unwrap()));
+    let seen = told[0].lock().unwrap().clone();
+    let total = seen[0].1;
+    // One photon per stratum: 32² pixels and the film's margin, 1² strata.
+    assert_eq!(total, 34 * 34, "{seen:?}");
+    assert!(seen.windows(2).all(|w| w[0].0 <= w[1].0 && w[1].1 == total), "{seen:?}");
+    assert_eq!(seen.last(), Some(&(total, total)));
+    assert!(seen.len() > 2 && seen[0].0 < total, "{seen:?}");
+    assert!(told[1].lock().unwrap().is_empty() && told[2].lock().unwrap().is_empty());
+
+    for (who, after) in [(1usize, 50u64), (0, 0)] {
+        let asked = AtomicU64::new(0);
+        let stop = || asked.fetch_add(1, Ordering::Relaxed) >= after;
+        let out = outcomes(3, |c| {
+            let watch = if c.rank() == who {
+                volume::Watch::new(&stop, &|_, _| {})
+            } else {
+                volume::Watch::NONE
+            };
+            volume::rank_from(c, &job, &job, watch)
+        });
+        for (r, o) in out.iter().enumerate() {
+            let e = o.as_ref().err().unwrap_or_else(|| panic!("rank {r} was not stopped"));
+            // A peer hears the abort, or finds the stopped rank gone
+            // (threads drop their channels); never a timeout.
+            let heard = [format!("rank {who} failed"), format!("rank {who} is gone")];
+            let ok = if r == who {
+                e.contains("the run was stopped")
+            } else {
+                heard.iter().any(|h| e.contains(h.as_str()))
+            };
+            assert!(ok, "stopping rank {who}: rank {r} says {e}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// BOS and focusing schlieren of the blast wave, each rank holding only
@@ -306,8 +379,9 @@ fn bos_and_focusing_across_ranks_equal_one_process_bit_for_bit() {
     let (fsetup, fwhole) = volume::focusing_single(&job, &job, &focusing, 5).unwrap();
     assert_ne!(f64_bits(&fwhole.flow), f64_bits(&fwhole.reference));
     for ranks in [1usize, 2, 3, 4] {
-        let ((s, images), reports) =
-            on_ranks(ranks, |c| Ok(volume::bos_rank(c, &job, &piece(ranks, c.rank())?, &bos, 5)?));
+        let ((s, images), reports) = on_ranks(ranks, |c| {
+            Ok(volume::bos_rank(c, &job, &piece(ranks, c.rank())?, &bos, 5, volume::Watch::NONE)?)
+        });
         assert_eq!(s.rig, setup.rig, "{ranks} ranks: another rig");
         assert_eq!(f64_bits(&images.flow), f64_bits(&whole.flow), "{ranks} ranks: BOS flow");
         let d = |i: &rt_photo::BosImages| {
@@ -319,7 +393,14 @@ fn bos_and_focusing_across_ranks_equal_one_process_bit_for_bit() {
             assert!(reports.iter().all(|r| r.brick_samples < r.grid_samples));
         }
         let ((s, images), _) = on_ranks(ranks, |c| {
-            Ok(volume::focusing_rank(c, &job, &piece(ranks, c.rank())?, &focusing, 5)?)
+            Ok(volume::focusing_rank(
+                c,
+                &job,
+                &piece(ranks, c.rank())?,
+                &focusing,
+                5,
+                volume::Watch::NONE,
+            )?)
         });
         assert_eq!(s.rig, fsetup.rig, "{ranks} ranks: another focusing rig");
         assert_eq!(f64_bits(&images.flow), f64_bits(&fwhole.flow), "{ranks} ranks: focusing");

@@ -8,6 +8,7 @@
 //! number from a result), so the two runs ask for the same rays.
 
 use alloc::{format, vec, vec::Vec};
+use core::sync::atomic::{AtomicU64, Ordering};
 use std::{sync::Mutex, time::Instant};
 
 use glam::DVec3;
@@ -22,7 +23,7 @@ use rt_volume::{
 };
 
 use super::{
-    BrickSource, DistributedError, MAX_PHOTONS, VolumeJob, VolumeRank,
+    BrickSource, DistributedError, MAX_PHOTONS, VolumeJob, VolumeRank, Watch,
     wire::{Key, Words, key, put_count, put_photon, put_result, unkey},
 };
 
@@ -51,16 +52,19 @@ pub(crate) struct Across<'a, C: Communicator> {
     pub(crate) params: TraceParams,
     bricks: Bricks,
     field: BrickField,
+    watch: Watch<'a>,
     /// What this rank has done.
     pub(crate) report: VolumeRank,
 }
 
 impl<'a, C: Communicator> Across<'a, C> {
-    /// Reads this rank's brick of `source` (as `job` takes its samples).
+    /// Reads this rank's brick of `source` (as `job` takes its samples);
+    /// its traces are watched by `watch`.
     pub(crate) fn new(
         comm: &'a C,
         job: &VolumeJob,
         source: &dyn BrickSource,
+        watch: Watch<'a>,
     ) -> Result<Self, DistributedError> {
         let t = Instant::now();
         let (info, ambient) = job.header(source)?;
@@ -73,39 +77,63 @@ impl<'a, C: Communicator> Across<'a, C> {
             ..VolumeRank::default()
         };
         report.seconds[0] = t.elapsed().as_secs_f64();
-        Ok(Self { comm, batch: job.batch.max(1), info, ambient, params, bricks, field, report })
+        let batch = job.batch.max(1);
+        Ok(Self { comm, batch, info, ambient, params, bricks, field, watch, report })
     }
 
     /// Traces the rays `emit` asks of its tracer (it is run on every rank
     /// with a tracer that records them and answers a straight ray):
-    /// rank 0 gets every result; the others `None`.
+    /// rank 0 gets every result, the others `None`; rank 0 tells the
+    /// watch its progress if `counted`.
     pub(crate) fn trace(
         &mut self,
         emit: impl FnOnce(&Tracer<'_>) -> Result<(), DistributedError>,
-    ) -> Result<Option<Traced>, DistributedError> {
+        counted: bool,
+    ) -> Result<Option<Traced<'a>>, DistributedError> {
         let t = Instant::now();
         let me = self.comm.rank();
         let ranks = self.comm.size();
         let (bounds, ambient, params) = (self.info.bounds(), self.ambient, self.params);
-        // This rank's photons: those entering its brick (rank 0: also
-        // those missing the volume, whose result needs no field).
+        let watch = self.watch;
+        let bricks = &self.bricks;
+        // This rank's photons, found as the instrument lists them: those
+        // entering its brick (rank 0: also those missing the volume,
+        // whose result needs no field).
+        let mine = |k: Key| -> Result<Option<Entry>, TraceError> {
+            let (o, d) = unkey(&k);
+            Ok(match trace_begin(bounds, ambient, o, d, &params)? {
+                Begin::Missed(r) if me == 0 => Some(Entry::Done(k, r)),
+                Begin::Inside(s) if bricks.owner(s.position()) == me => Some(Entry::Queued(k, s)),
+                Begin::Missed(_) | Begin::Inside(_) => None,
+            })
+        };
+        let (entries, total) = match emissions(emit, watch, mine) {
+            // The first round fails and so tells the peers.
+            Err(_) if watch.stopped() => (Vec::new(), 0),
+            listed => listed?,
+        };
+        let tell = |done: usize| {
+            if counted && me == 0 {
+                (watch.progress)(done as u64, total);
+            }
+        };
         let mut queue: Vec<(Key, PathState)> = Vec::new();
         let mut done: Vec<(Key, TraceResult)> = Vec::new();
-        for k in emissions(emit)? {
-            let (o, d) = unkey(&k);
-            match trace_begin(bounds, ambient, o, d, &params)? {
-                Begin::Missed(r) if me == 0 => done.push((k, r)),
-                Begin::Missed(_) => {}
-                Begin::Inside(s) if self.bricks.owner(s.position()) == me => queue.push((k, s)),
-                Begin::Inside(_) => {}
+        for e in entries {
+            match e {
+                Entry::Queued(k, s) => queue.push((k, s)),
+                Entry::Done(k, r) => done.push((k, r)),
             }
         }
         let report = &mut self.report;
         report.entered += queue.len() as u64;
-        let (bricks, field, batch) = (&self.bricks, &self.field, self.batch);
+        let (field, batch) = (&self.field, self.batch);
         let mut results: Vec<(Key, TraceResult)> = Vec::new();
         let owns = |x: DVec3| bricks.owner(x) == me;
         let step = |_: u32, inbox: &[Batch], outbox: &mut [Vec<u8>]| {
+            if watch.stopped() {
+                return Err(DistributedError::Stopped);
+            }
             for b in inbox {
                 if b.bytes.is_empty() {
                     continue;
@@ -131,7 +159,14 @@ impl<'a, C: Communicator> Across<'a, C> {
             let legs: Vec<(Key, Result<Leg, TraceError>)> = queue
                 .split_off(queue.len() - take)
                 .into_par_iter()
-                .map(|(k, s)| (k, trace_leg(field, s, &params, owns)))
+                .map(|(k, s)| {
+                    let leg = if watch.stopped() {
+                        Err(TraceError::Stopped)
+                    } else {
+                        trace_leg(field, s, &params, owns)
+                    };
+                    (k, leg)
+                })
                 .collect();
             report.legs += legs.len() as u64;
             let mut handed: Vec<Vec<(Key, PathState)>> = vec![Vec::new(); ranks];
@@ -142,6 +177,7 @@ impl<'a, C: Communicator> Across<'a, C> {
                     Err(TraceError::BadField { at }) if !field.covers(at) => {
                         return Err(DistributedError::BeyondBrick { rank: me, at });
                     }
+                    Err(TraceError::Stopped) => return Err(DistributedError::Stopped),
                     Err(e) => return Err(e.into()),
                 }
             }
@@ -149,6 +185,7 @@ impl<'a, C: Communicator> Across<'a, C> {
             let finished: Vec<(Key, TraceResult)> = done.split_off(done.len() - send_now);
             if me == 0 {
                 results.extend(finished.iter().copied());
+                tell(results.len());
             }
             for (peer, out) in outbox.iter_mut().enumerate() {
                 let to_zero = peer == 0 && me != 0 && !finished.is_empty();
@@ -169,13 +206,14 @@ impl<'a, C: Communicator> Across<'a, C> {
             Ok(!queue.is_empty() || !done.is_empty())
         };
         let stats = rounds(self.comm, 1_000_000, step).map_err(|e| exchange_error(me, e))?;
+        tell(results.len());
         let sum = &mut self.report.exchange;
         sum.rounds += stats.rounds;
         sum.messages += stats.messages;
         sum.bytes_sent += stats.bytes_sent;
         sum.largest_message = sum.largest_message.max(stats.largest_message);
         self.report.seconds[1] += t.elapsed().as_secs_f64();
-        Ok((me == 0).then(|| Traced::new(results)))
+        Ok((me == 0).then(|| Traced::new(results, watch)))
     }
 
     /// Rank 0's `bytes` on every rank (the others' are not sent).
@@ -190,62 +228,91 @@ impl<'a, C: Communicator> Across<'a, C> {
     }
 }
 
-/// Every ray's result, on rank 0.
-pub(crate) struct Traced(Vec<(Key, TraceResult)>);
+/// Every ray's result, on rank 0; looked up until the watch says to
+/// stop.
+pub(crate) struct Traced<'a> {
+    results: Vec<(Key, TraceResult)>,
+    watch: Watch<'a>,
+}
 
-impl Traced {
-    fn new(mut results: Vec<(Key, TraceResult)>) -> Self {
+impl<'a> Traced<'a> {
+    fn new(mut results: Vec<(Key, TraceResult)>, watch: Watch<'a>) -> Self {
         results.sort_unstable_by_key(|(k, _)| *k);
-        Self(results)
+        // A ray asked for twice was traced twice, alike.
+        results.dedup_by_key(|(k, _)| *k);
+        Self { results, watch }
     }
 
     /// The result of the ray from `o` along `d` ([`TraceError::InvalidRay`]
     /// if it was never asked for: see [`missing`]).
     pub(crate) fn get(&self, o: DVec3, d: DVec3) -> Result<TraceResult, TraceError> {
+        if self.watch.stopped() {
+            return Err(TraceError::Stopped);
+        }
         let k = key(o, d);
-        let i = self.0.binary_search_by_key(&k, |(k, _)| *k).map_err(|_| TraceError::InvalidRay)?;
-        Ok(self.0[i].1)
+        let found = self.results.binary_search_by_key(&k, |(k, _)| *k);
+        Ok(self.results[found.map_err(|_| TraceError::InvalidRay)?].1)
     }
 
     /// Every result, in the rays' order.
     pub(crate) fn results(&self) -> impl Iterator<Item = &TraceResult> {
-        self.0.iter().map(|(_, r)| r)
+        self.results.iter().map(|(_, r)| r)
     }
 }
 
-/// A lookup's [`TraceError::InvalidRay`] as the missing result it is.
+/// A lookup's error as what it is: a missing result, or a stop.
 pub(crate) fn missing(e: TraceError) -> DistributedError {
     match e {
         TraceError::InvalidRay => DistributedError::MissingResult,
+        TraceError::Stopped => DistributedError::Stopped,
         e => e.into(),
     }
 }
 
-/// The rays `emit` asks for, each once, by key; refused past
-/// [`MAX_PHOTONS`] (every rank lists them; the instrument is stopped at
-/// the first ray beyond).
-pub(crate) fn emissions(
+/// A ray this rank starts with: to trace, or (rank 0) already done.
+enum Entry {
+    Queued(Key, PathState),
+    Done(Key, TraceResult),
+}
+
+/// What `keep` keeps of the rays `emit` asks for (by key, on the
+/// instrument's threads, each thread into its own list), and how many it
+/// asked for; refused past [`MAX_PHOTONS`] (the instrument is stopped at
+/// the first ray beyond), or once `watch` says to stop. A ray asked for
+/// twice is kept twice (its two results are the same).
+pub(crate) fn emissions<T: Send>(
     emit: impl FnOnce(&Tracer<'_>) -> Result<(), DistributedError>,
-) -> Result<Vec<Key>, DistributedError> {
-    let seen = Mutex::new(Vec::new());
+    watch: Watch<'_>,
+    keep: impl Fn(Key) -> Result<Option<T>, TraceError> + Sync,
+) -> Result<(Vec<T>, u64), DistributedError> {
+    let lists: Vec<Mutex<Vec<T>>> =
+        (0..=rayon::current_num_threads()).map(|_| Mutex::new(Vec::new())).collect();
+    let asked = AtomicU64::new(0);
     let emitted = emit(&|o, d| {
-        let mut seen = seen.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        if seen.len() as u64 > MAX_PHOTONS {
+        if watch.stopped() {
+            return Err(TraceError::Stopped);
+        }
+        if asked.fetch_add(1, Ordering::Relaxed) >= MAX_PHOTONS {
             // Ends the instrument's run: too many, reported below.
             return Err(TraceError::InvalidRay);
         }
-        seen.push(key(o, d));
+        if let Some(t) = keep(key(o, d))? {
+            // Uncontended: a list per worker thread (0: any other thread).
+            let i = rayon::current_thread_index().map_or(0, |i| i + 1) % lists.len();
+            lists[i].lock().unwrap_or_else(std::sync::PoisonError::into_inner).push(t);
+        }
         Ok(straight(o, d))
     });
-    let mut keys = seen.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner);
-    if keys.len() as u64 > MAX_PHOTONS {
-        let photons = keys.len() as u64;
-        return Err(DistributedError::TooManyPhotons { photons, max: MAX_PHOTONS });
+    let asked = asked.into_inner();
+    if asked > MAX_PHOTONS {
+        return Err(DistributedError::TooManyPhotons { photons: asked, max: MAX_PHOTONS });
     }
     emitted?;
-    keys.sort_unstable();
-    keys.dedup();
-    Ok(keys)
+    let mut kept = Vec::new();
+    for list in lists {
+        kept.append(&mut list.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner));
+    }
+    Ok((kept, asked))
 }
 
 /// A photon that went straight, nothing done.

@@ -16,31 +16,34 @@ use rt_composite::Communicator;
 use rt_volume::{Bounds, GridField, TraceParams, trace};
 
 use super::{
-    BrickSource, DistributedError, MAX_PHOTONS, VolumeJob, VolumeRank,
+    BrickSource, DistributedError, MAX_PHOTONS, VolumeJob, VolumeRank, Watch,
     across::{Across, Tracer, missing},
     wire::Words,
 };
 use crate::{
-    BosError, BosImages, BosOptions, BosSetup, FocusingError, FocusingImages, FocusingOptions,
-    FocusingSetup, SchlierenBench, SetupError, Survey,
+    BenchError, BosError, BosImages, BosOptions, BosSetup, FocusingError, FocusingImages,
+    FocusingOptions, FocusingSetup, SchlierenBench, SetupError, Survey,
 };
 
 /// What a rank returns: rank 0 the set-up chosen and its images.
 pub type CameraRank<S, I> = (Option<(S, I)>, VolumeRank);
 
 /// BOS of the grid `source` holds (this rank's part of it) with the rig
-/// [`BosSetup::choose`] would choose, every ray traced across the ranks.
+/// [`BosSetup::choose`] would choose, every ray traced across the ranks,
+/// watched by `watch` (progress in camera rays).
 ///
 /// # Errors
-/// A bad option, any rank's failure.
+/// A bad option, any rank's failure; [`DistributedError::Stopped`] once
+/// `watch` says to stop.
 pub fn bos_rank<C: Communicator>(
     comm: &C,
     job: &VolumeJob,
     source: &dyn BrickSource,
     options: &BosOptions,
     seed: u64,
+    watch: Watch<'_>,
 ) -> Result<CameraRank<BosSetup, BosImages>, DistributedError> {
-    on_ranks(comm, job, source, bos_choose(options), bos_render(seed))
+    on_ranks(comm, job, source, watch, bos_choose(options), bos_render(seed))
 }
 
 /// [`bos_rank`] in one process holding the whole grid.
@@ -58,18 +61,19 @@ pub fn bos_single(
 
 /// Focusing schlieren of the grid `source` holds (this rank's part of
 /// it) with the rig [`FocusingSetup::choose`] would choose, every ray
-/// traced across the ranks.
+/// traced across the ranks, watched by `watch` (progress in camera rays).
 ///
 /// # Errors
-/// A bad option, any rank's failure.
+/// As [`bos_rank`].
 pub fn focusing_rank<C: Communicator>(
     comm: &C,
     job: &VolumeJob,
     source: &dyn BrickSource,
     options: &FocusingOptions,
     seed: u64,
+    watch: Watch<'_>,
 ) -> Result<CameraRank<FocusingSetup, FocusingImages>, DistributedError> {
-    on_ranks(comm, job, source, focusing_choose(options), focusing_render(seed))
+    on_ranks(comm, job, source, watch, focusing_choose(options), focusing_render(seed))
 }
 
 /// [`focusing_rank`] in one process holding the whole grid.
@@ -141,13 +145,14 @@ fn on_ranks<C: Communicator, S, I>(
     comm: &C,
     job: &VolumeJob,
     source: &dyn BrickSource,
+    watch: Watch<'_>,
     choose: impl FnOnce(Bounds, TraceParams, &mut SurveyFn<'_>) -> Result<S, DistributedError>,
     render: impl Fn(&S, &Tracer<'_>) -> Result<I, DistributedError>,
 ) -> Result<CameraRank<S, I>, DistributedError> {
-    let mut across = Across::new(comm, job, source)?;
+    let mut across = Across::new(comm, job, source, watch)?;
     let (bounds, params) = (across.info.bounds(), across.params);
     let setup = choose(bounds, params, &mut |probe| survey_across(&mut across, probe))?;
-    let Some(traced) = across.trace(|t| render(&setup, t).map(drop))? else {
+    let Some(traced) = across.trace(|t| render(&setup, t).map(drop), true)? else {
         return Ok((None, across.report));
     };
     let t = Instant::now();
@@ -163,10 +168,14 @@ fn survey_across<C: Communicator>(
     probe: &SchlierenBench,
 ) -> Result<Survey, DistributedError> {
     let width = Survey::WIDTH;
-    let traced = across.trace(|t| Ok(Survey::of_with(probe, width, &t).map(drop)?))?;
+    let traced = across.trace(|t| Ok(Survey::of_with(probe, width, &t).map(drop)?), false)?;
     let mut bytes = Vec::new();
     if let Some(traced) = traced {
-        let survey = Survey::of_with(probe, width, &|o, d| traced.get(o, d))?;
+        let survey =
+            Survey::of_with(probe, width, &|o, d| traced.get(o, d)).map_err(|e| match e {
+                SetupError::SchlierenBench(BenchError::Trace(e)) => missing(e),
+                e => e.into(),
+            })?;
         for e in &survey.eps {
             let (flag, (a, b)) = e.map_or((0u64, (0.0, 0.0)), |e| (1, e));
             for w in [flag, a.to_bits(), b.to_bits()] {

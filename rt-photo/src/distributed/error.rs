@@ -64,6 +64,9 @@ pub enum DistributedError {
     },
     /// Rank 0 holds no result for a photon the bench emits.
     MissingResult,
+    /// This rank's [`super::Watch`] said to stop (its peers fail with
+    /// [`DistributedError::Exchange`], "rank r failed").
+    Stopped,
     /// A [`super::Piece`] lacks samples the run reads.
     Piece {
         /// First sample asked for.
@@ -101,6 +104,7 @@ impl fmt::Display for DistributedError {
             Self::Malformed { from } => write!(f, "rank {from} sent a malformed batch"),
             Self::Exchange { rank, message } => write!(f, "rank {rank}: {message}"),
             Self::MissingResult => f.write_str("rank 0: a photon's result is missing"),
+            Self::Stopped => f.write_str("the run was stopped"),
             Self::Piece { lo, hi, held: (at, dims) } => write!(
                 f,
                 "samples {lo:?}..{hi:?} are needed, the piece holds {dims:?} from {at:?} (too few ghost layers)"

@@ -12,8 +12,8 @@ use rt_volume::{
 };
 
 use super::{
-    BATCH, DistributedError, MAX_PHOTONS,
-    across::emissions,
+    BATCH, DistributedError, MAX_PHOTONS, Watch,
+    across::{Tracer, emissions},
     wire::{PHOTON_BYTES, RESULT_BYTES, unkey},
 };
 use crate::{Axis, Cutoff, Film, Filter, Mode, Reconstruction, SchlierenBench, Weighting};
@@ -295,10 +295,14 @@ pub fn single_from(job: &VolumeJob, source: &dyn BrickSource) -> Result<Film, Di
     let bench = job.bench(&info, ambient, 1.0);
     let mut film = job.film(&bench)?;
     let bench = if job.optics == VolumeOptics::Knife {
-        let keys = emissions(|t| {
+        let emit = |t: &Tracer<'_>| {
             let mut scratch = Film::new(film.width(), film.height(), Filter::Tent)?;
             Ok(bench.render_with(&t, &mut scratch, 0, job.seed)?)
-        })?;
+        };
+        let (mut keys, _) = emissions(emit, Watch::NONE, |k| Ok(Some(k)))?;
+        // As rank 0 holds them: each ray once.
+        keys.sort_unstable();
+        keys.dedup();
         let results = keys
             .par_iter()
             .map(|k| {

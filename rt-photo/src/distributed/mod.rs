@@ -49,12 +49,14 @@ mod camera;
 mod error;
 mod job;
 mod rank;
+mod watch;
 mod wire;
 
 pub use camera::{CameraRank, bos_rank, bos_single, focusing_rank, focusing_single};
 pub use error::DistributedError;
 pub use job::{BrickSource, Piece, VolumeJob, VolumeOptics, VolumeRank, same, single, single_from};
 pub use rank::{first_brick_box, rank, rank_from};
+pub use watch::Watch;
 pub use wire::{PHOTON_BYTES, RESULT_BYTES};
 
 /// Photons a rank advances per round, and most results it sends rank 0

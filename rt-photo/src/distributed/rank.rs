@@ -6,7 +6,7 @@ use rt_composite::Communicator;
 use rt_volume::{Bricks, GridInfo, step_reach};
 
 use super::{
-    BrickSource, DistributedError, VolumeJob, VolumeOptics, VolumeRank,
+    BrickSource, DistributedError, VolumeJob, VolumeOptics, VolumeRank, Watch,
     across::{Across, FIRST_GRADIENT, FIRST_N, missing},
     job::knife_range,
 };
@@ -40,27 +40,33 @@ pub fn rank<C: Communicator>(
     comm: &C,
     job: &VolumeJob,
 ) -> Result<(Option<Film>, VolumeRank), DistributedError> {
-    rank_from(comm, job, job)
+    rank_from(comm, job, job, Watch::NONE)
 }
 
 /// [`rank`] with this rank's samples from `source` (each rank its own:
-/// a [`super::Piece`] covering [`first_brick_box`]).
+/// a [`super::Piece`] covering [`first_brick_box`]), watched by `watch`
+/// (progress in photons).
 ///
 /// # Errors
-/// As [`rank`]; a piece that lacks samples a step reaches.
+/// As [`rank`]; a piece that lacks samples a step reaches;
+/// [`DistributedError::Stopped`] once `watch` says to stop.
 pub fn rank_from<C: Communicator>(
     comm: &C,
     job: &VolumeJob,
     source: &dyn BrickSource,
+    watch: Watch<'_>,
 ) -> Result<(Option<Film>, VolumeRank), DistributedError> {
-    let mut across = Across::new(comm, job, source)?;
+    let mut across = Across::new(comm, job, source, watch)?;
     let (info, ambient) = (across.info, across.ambient);
     let bench = job.bench(&info, ambient, 1.0);
     let film = job.film(&bench)?;
-    let traced = across.trace(|t| {
-        let mut scratch = Film::new(film.width(), film.height(), Filter::Tent)?;
-        Ok(bench.render_with(&t, &mut scratch, 0, job.seed)?)
-    })?;
+    let traced = across.trace(
+        |t| {
+            let mut scratch = Film::new(film.width(), film.height(), Filter::Tent)?;
+            Ok(bench.render_with(&t, &mut scratch, 0, job.seed)?)
+        },
+        true,
+    )?;
     let Some(traced) = traced else {
         return Ok((None, across.report));
     };

@@ -93,3 +93,35 @@ if rank == 0:
     assert np.array_equal(got["focusing"].reshape(relative.shape)[::-1], relative), \
         "RT Focusing Schlieren across ranks differs from one process"
     print(f"schlieren, bos, focusing on {n} ranks: equal to one process holding the whole grid")
+
+# Across ranks, rank 0 reports progress to ParaView (ProgressEvent, up to
+# 1), and ParaView's abort there stops every rank: each output empty,
+# none waiting for the exchange's 60 s timeout.
+seen = []
+watched = RTSchlieren(Input=reader, Array=["POINTS", "density"], Size=256, Photons=4)
+watched.GetClientSideObject().AddObserver("ProgressEvent", lambda o, e: seen.append(o.GetProgress()))
+watched.UpdatePipeline()
+if rank == 0:
+    assert seen and max(seen) == 1.0 and len(set(seen)) > 3, seen
+    print(f"progress on {n} ranks: {len(seen)} reports up to {max(seen)}")
+else:
+    assert not [p for p in seen if 0 < p < 1], f"rank {rank} reported progress {seen}"
+
+
+def abort(algorithm, _):
+    if 0 < algorithm.GetProgress() < 1:
+        algorithm.SetAbortExecute(1)
+
+
+aborted = RTSchlieren(Input=reader, Array=["POINTS", "density"], Size=256, Photons=16, Seed=2)
+if rank == 0:
+    aborted.GetClientSideObject().AddObserver("ProgressEvent", abort)
+comm.Barrier()
+t = time.perf_counter()
+aborted.UpdatePipeline()
+took = comm.gather(time.perf_counter() - t, root=0)
+points = comm.gather(aborted.GetClientSideObject().GetOutputDataObject(0).GetNumberOfPoints(), root=0)
+if rank == 0:
+    assert points == [0] * n, points
+    print(f"abort on {n} ranks: every output empty after {max(took):.2f} s (all ranks)")
+    assert max(took) < 30.0, took

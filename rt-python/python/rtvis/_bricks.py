@@ -6,7 +6,7 @@ communicator."""
 from __future__ import annotations
 
 import inspect
-from typing import Any, Callable, Dict, Optional, Sequence, Tuple, TypeVar
+from typing import Any, Callable, Dict, Optional, Sequence, Tuple, TypeVar, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -17,6 +17,7 @@ from ._bos import _bos_args, _bos_result
 from ._composite import _Mpi4pyComm, _mpi_comm
 from ._focusing import _focusing_args, _focusing_result
 from ._volume import GLADSTONE_DALE_AIR, _INTERPOLATIONS, _QUANTITIES
+from ._watch import ProgressCallback, _progress
 
 _T = TypeVar("_T")
 Box = Tuple[Tuple[int, int, int], Tuple[int, int, int]]
@@ -52,8 +53,8 @@ def schlieren_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int
                      spacing: ArrayLike = (1.0, 1.0, 1.0), origin: ArrayLike = (0.0, 0.0, 0.0),
                      quantity: str = "density", k: float = GLADSTONE_DALE_AIR, interpolation: str = "cubic",
                      cutoff: str = "knife", wavelength: float = 10.6e-6, fringe_spacing: Optional[float] = None,
-                     size: int = 512, strata: int = 4, seed: int = 1,
-                     timeout: float = 60.0) -> Optional[NDArray[np.float64]]:
+                     size: int = 512, strata: int = 4, seed: int = 1, timeout: float = 60.0,
+                     progress: Union[None, bool, ProgressCallback] = None) -> Optional[NDArray[np.float64]]:
     """Schlieren along z of a grid of ``shape`` ``(nz, ny, nx)`` whose
     samples are split over the ranks of ``comm`` (an mpi4py communicator,
     default ``MPI.COMM_WORLD``): this rank holds ``piece``, ``[z, y, x]``
@@ -71,20 +72,29 @@ def schlieren_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int
     survey the whole volume first), so the images are not
     :func:`schlieren`'s. A piece short of its ghost layers raises
     ``ValueError`` naming the samples it lacks.
+
+    ``progress``: ``True`` draws a progress bar on stderr, a callable is
+    called as ``progress(done, total)`` (photons whose results rank 0
+    holds), both on rank 0 only. Ctrl-C (or an exception from the
+    callback) on any rank stops every rank within a round of the trade:
+    that rank raises ``KeyboardInterrupt`` (or the callback's exception),
+    the others ``ValueError`` naming it.
     """
     optics = _choice("cutoff", cutoff, ("knife", "interferometry"))
     extra = (_float("wavelength", wavelength), _float("fringe_spacing", fringe_spacing, optional=True),
              _uint("size", size), _integer("strata", strata, 1, 64), _uint("seed", seed, 64))
     out: Optional[NDArray[np.float64]] = _on_ranks(
         "schlieren_pieces", piece, start, shape, comm, spacing, origin, quantity, k, interpolation, timeout,
-        lambda held, transport: _rtvis._schlieren_piece(*(held + (optics,) + extra), comm=transport))
+        progress, lambda held, transport, told: _rtvis._schlieren_piece(*(held + (optics,) + extra),
+                                                                        comm=transport, progress=told))
     return out
 
 
 def bos_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int], comm: Any = None,
                spacing: ArrayLike = (1.0, 1.0, 1.0), origin: ArrayLike = (0.0, 0.0, 0.0),
                quantity: str = "density", k: float = GLADSTONE_DALE_AIR, interpolation: str = "cubic",
-               timeout: float = 60.0, chosen: bool = False, **options: Any) -> Optional[Tuple[Any, ...]]:
+               timeout: float = 60.0, chosen: bool = False, progress: Union[None, bool, ProgressCallback] = None,
+               **options: Any) -> Optional[Tuple[Any, ...]]:
     """:func:`bos` of a grid split over the ranks of ``comm`` as for
     :func:`schlieren_pieces` (each rank its ``piece``): the survey that
     chooses the rig and every camera ray are traced across the ranks, so
@@ -96,13 +106,15 @@ def bos_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int], com
     ``dot_spacing`` too, so it repeats with this function). Every ray is traced exactly
     through the grid (no skipping of still air), so the images differ
     slightly from :func:`bos` of a :class:`Volume`, which skips within a
-    tenth of a pixel."""
+    tenth of a pixel. ``progress`` (camera rays) and Ctrl-C as for
+    :func:`schlieren_pieces`."""
     if "dot_spacing" in options:
         options["spacing"] = options.pop("dot_spacing")
     args, fixed = _options(_bos_args, "bos_pieces", options)
     fixed["dot_spacing"] = fixed.pop("spacing")
     out = _on_ranks("bos_pieces", piece, start, shape, comm, spacing, origin, quantity, k, interpolation, timeout,
-                    lambda held, transport: _rtvis._bos_piece(*(held + args), comm=transport))
+                    progress, lambda held, transport, told: _rtvis._bos_piece(*(held + args), comm=transport,
+                                                                              progress=told))
     if out is None:
         return None
     *images, said, rig = out
@@ -112,7 +124,8 @@ def bos_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int], com
 def focusing_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int], comm: Any = None,
                     spacing: ArrayLike = (1.0, 1.0, 1.0), origin: ArrayLike = (0.0, 0.0, 0.0),
                     quantity: str = "density", k: float = GLADSTONE_DALE_AIR, interpolation: str = "cubic",
-                    timeout: float = 60.0, chosen: bool = False, **options: Any) -> Optional[Tuple[Any, ...]]:
+                    timeout: float = 60.0, chosen: bool = False, progress: Union[None, bool, ProgressCallback] = None,
+                    **options: Any) -> Optional[Tuple[Any, ...]]:
     """:func:`focusing` of a grid split over the ranks of ``comm`` as for
     :func:`schlieren_pieces` (each rank its ``piece``): the survey that
     chooses the grid's pitch and every camera ray are traced across the
@@ -121,10 +134,12 @@ def focusing_pieces(piece: ArrayLike, start: Sequence[int], shape: Sequence[int]
     holding the whole grid, at any rank count. ``options`` are
     :func:`focusing`'s keywords. Every ray is traced exactly through the
     grid (no skipping of still air), so the images differ slightly from
-    :func:`focusing` of a :class:`Volume`."""
+    :func:`focusing` of a :class:`Volume`. ``progress`` (camera rays)
+    and Ctrl-C as for :func:`schlieren_pieces`."""
     args, fixed = _options(_focusing_args, "focusing_pieces", options)
     out = _on_ranks("focusing_pieces", piece, start, shape, comm, spacing, origin, quantity, k, interpolation,
-                    timeout, lambda held, transport: _rtvis._focusing_piece(*(held + args), comm=transport))
+                    timeout, progress, lambda held, transport, told: _rtvis._focusing_piece(
+                        *(held + args), comm=transport, progress=told))
     if out is None:
         return None
     *images, said, rig = out
@@ -143,11 +158,14 @@ def _options(check: Callable[..., Tuple[_T, Dict[str, Any]]], name: str,
 
 def _on_ranks(name: str, piece: ArrayLike, start: Sequence[int], shape: Sequence[int], comm: Any,
               spacing: ArrayLike, origin: ArrayLike, quantity: str, k: float, interpolation: str, timeout: float,
-              run: Callable[[_Held, _Mpi4pyComm], Any]) -> Any:
-    """``run(held, transport)`` on every rank of ``comm``: ``held`` is the
-    piece and the grid as ``_rtvis``'s ``_*_piece`` functions take them
-    first, ``transport`` the communicator they trade over."""
+              progress: Union[None, bool, ProgressCallback],
+              run: Callable[[_Held, _Mpi4pyComm, Optional[ProgressCallback]], Any]) -> Any:
+    """``run(held, transport, told)`` on every rank of ``comm``: ``held``
+    is the piece and the grid as ``_rtvis``'s ``_*_piece`` functions take
+    them first, ``transport`` the communicator they trade over, ``told``
+    the progress callback (rank 0 alone is told)."""
     comm = _mpi_comm(comm, name)
+    told = _progress(progress, f"rtvis.{name}")
     values = _array("piece", piece, 3, np.float32)
     if len(start) != 3:
         raise ValueError(f"start: expected (z, y, x), got {tuple(start)}")
@@ -166,7 +184,7 @@ def _on_ranks(name: str, piece: ArrayLike, start: Sequence[int], shape: Sequence
     ok = False
     try:
         held: _Held = (values, (x0, y0, z0), (x, y, z), *space, float(firsts[0]), *grid)
-        out = run(held, transport)
+        out = run(held, transport, told)
         ok = True
         return out
     finally:

@@ -79,17 +79,17 @@ def _brick_box(dims: Sequence[int], spacing: _Vec3, origin: _Vec3, interpolation
 def _schlieren_piece(piece: NDArray[np.float32], lo: Sequence[int], dims: Sequence[int], spacing: _Vec3,
                      origin: _Vec3, first: float, quantity: str, k: float, interpolation: str, optics: str,
                      wavelength: float, fringe_spacing: Optional[float], size: int, strata: int, seed: int,
-                     comm: Any) -> Optional[NDArray[np.float64]]: ...
+                     comm: Any, progress: _Progress = None) -> Optional[NDArray[np.float64]]: ...
 def _bos_piece(piece: NDArray[np.float32], lo: Sequence[int], dims: Sequence[int], spacing: _Vec3, origin: _Vec3,
                first: float, quantity: str, k: float, interpolation: str, axis_name: str, size: int,
                focal_length: Optional[float], f_number: float, pixel: Optional[float], distance: Optional[float],
                background_distance: Optional[float], dot: float, spacing_dots: float, samples: int, seed: int,
-               background: str, image: Optional[NDArray[np.float64]], image_pixel: Optional[float], comm: Any
-               ) -> Optional[Tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], str, Dict[str, float]]]: ...
+               background: str, image: Optional[NDArray[np.float64]], image_pixel: Optional[float], comm: Any,
+               progress: _Progress = None) -> Optional[Tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], str, Dict[str, float]]]: ...
 def _focusing_piece(piece: NDArray[np.float32], lo: Sequence[int], dims: Sequence[int], spacing: _Vec3,
                     origin: _Vec3, first: float, quantity: str, k: float, interpolation: str,
                     axis_name: str, size: int, focal_length: Optional[float], aperture: Optional[float],
                     pixel: Optional[float], distance: Optional[float], focus: float,
                     source_distance: Optional[float], pitch: Optional[float], duty: float, angle: float,
-                    offset: float, bands: Optional[int], samples: int, seed: int, comm: Any
-                    ) -> Optional[Tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], str, Dict[str, float]]]: ...
+                    offset: float, bands: Optional[int], samples: int, seed: int, comm: Any,
+                    progress: _Progress = None) -> Optional[Tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], str, Dict[str, float]]]: ...
