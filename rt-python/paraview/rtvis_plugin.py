@@ -135,6 +135,42 @@ def _display_defaults():
 _display_defaults()
 
 
+def _rgb_as_is():
+    """Shows the colour images (``RGB``, 8-bit sRGB: RT Surface Render,
+    RT Schlieren's colour filter) as they are, not through a colour map:
+    when ParaView colours a display of theirs by ``RGB`` (as it does on
+    Apply, ``RGB`` being their active scalars), Map Scalars is unticked,
+    once per display, so the user's own later choice stands. ParaView 5.11
+    has no per-filter default for Map Scalars, so this watches the proxy
+    manager: the colour map that colouring registers is the cue."""
+    try:
+        from paraview import servermanager
+        from paraview.servermanager import vtkSMProxyManager
+    except ImportError:  # a process without the server manager
+        return
+    done = set()
+
+    def look(_object, _event):
+        if servermanager.ActiveConnection is None:
+            return
+        for rep in servermanager.ProxyManager().GetProxiesInGroup("representations").values():
+            key = rep.GetGlobalID()
+            if key in done or rep.GetProperty("MapScalars") is None or rep.GetProperty("Input") is None:
+                continue
+            source = rep.Input
+            colour = rep.GetProperty("ColorArrayName")
+            if source is None or colour is None or source.GetXMLName() not in ("RTSurfaceRender", "RTSchlieren"):
+                continue
+            if list(colour)[-1] == "RGB":
+                done.add(key)
+                rep.MapScalars = 0
+
+    vtkSMProxyManager.GetProxyManager().AddObserver("RegisterEvent", look)
+
+
+_rgb_as_is()
+
+
 class _Aborted(Exception):
     """ParaView asked the filter to abort (its progress bar's button)."""
 

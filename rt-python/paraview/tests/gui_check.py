@@ -41,6 +41,12 @@ try:
 
         pvs.Hide(image, view)
         contour = pvs.Contour(Input=src, ContourBy=["POINTS", "RTData"], Isosurfaces=[150.0])
+        # RT Surface Render's RGB shown as it is, not through a colour map.
+        surface = pvs.Show(pvs.RTSurfaceRender(Input=contour, ImageSize=[64, 48]), view)
+        as_is = list(surface.ColorArrayName) == ["POINTS", "RGB"] and surface.MapScalars == 0
+        msg.append(f"RT Surface Render shown by {list(surface.ColorArrayName)}, Map Scalars {surface.MapScalars}")
+        ok = ok and as_is
+        pvs.Hide(surface.Input, view)
         shown = pvs.Show(pvs.Elevation(Input=contour, LowPoint=[0, -10, 0], HighPoint=[0, 10, 0]), view)
         pvs.ColorBy(shown, ("POINTS", "Elevation"))
         view.InteractionMode = "3D"
