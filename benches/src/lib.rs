@@ -5,3 +5,4 @@
 
 pub mod plot;
 pub mod scenes;
+pub mod watertight;

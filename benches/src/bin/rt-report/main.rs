@@ -3,6 +3,7 @@
 //!
 //! ```text
 //! cargo run --release -p rt-benches --bin rt-report -- traversal [--quick]
+//! cargo run --release -p rt-benches --bin rt-report -- watertight [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- grin [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- octree [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- schlieren [--quick]
@@ -37,6 +38,7 @@ mod timing;
 mod tinybvh;
 mod traversal;
 mod unstructured;
+mod watertight;
 
 use std::{io::Write as _, path::PathBuf, process::ExitCode};
 
@@ -113,7 +115,7 @@ fn index(sections: &[(&str, Section)], quick: bool, seconds: f64) -> String {
 const USAGE: &str = "usage: rt-report [AREA ...] [--quick]
 
 Writes tables, CSV files and plots under target/rt-report/.
-AREA: traversal, grin, octree, schlieren, noise, bos, focusing, render,
+AREA: traversal, watertight, grin, octree, schlieren, noise, bos, focusing, render,
 composite, unstructured, distributed (none or
 `all`: every one of these, plus target/rt-report/index.md), or gl (rt-gl
 against Mesa; needs xvfb-run, cc and glxgears; not part of `all`).
@@ -157,6 +159,7 @@ fn main() -> ExitCode {
     let areas = if all {
         vec![
             "traversal",
+            "watertight",
             "grin",
             "octree",
             "schlieren",
@@ -180,6 +183,7 @@ fn main() -> ExitCode {
     for area in areas {
         let result = match area {
             "traversal" => traversal::run(&dir, quick),
+            "watertight" => watertight::run(&dir, quick),
             "grin" => grin::run(&dir, quick),
             "octree" => octree::run(&dir, quick),
             "schlieren" => schlieren::run(&dir, quick),
@@ -192,7 +196,7 @@ fn main() -> ExitCode {
             "distributed" => distributed::run(&dir, quick),
             "gl" => gl::run(&dir, quick),
             other => Err(format!(
-                "unknown area `{other}` (known: traversal, grin, octree, schlieren, noise, bos, focusing, render, composite, unstructured, distributed, gl, all)"
+                "unknown area `{other}` (known: traversal, watertight, grin, octree, schlieren, noise, bos, focusing, render, composite, unstructured, distributed, gl, all)"
             )),
         };
         match result {
