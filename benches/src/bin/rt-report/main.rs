@@ -25,6 +25,8 @@ mod composite;
 mod distributed;
 #[cfg(feature = "embree3")]
 mod embree3;
+#[cfg(feature = "embree4")]
+mod embree4;
 mod focusing;
 mod gl;
 mod gl_programs;

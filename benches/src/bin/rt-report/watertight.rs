@@ -27,6 +27,9 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     if cfg!(feature = "embree3") {
         names.extend(["embree3", "embree3-robust"]);
     }
+    if cfg!(feature = "embree4") {
+        names.extend(["embree4", "embree4-robust"]);
+    }
     if cfg!(feature = "tinybvh") {
         names.push("tinybvh");
     }
@@ -76,6 +79,11 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             let mut ctx = crate::embree3::context();
             row.push(misses(case, |r| scene.closest(&mut ctx, r).is_some()));
         }
+        #[cfg(feature = "embree4")]
+        for robust in [false, true] {
+            let scene = crate::embree4::Embree4Scene::new(&m.positions, &m.indices, robust)?;
+            row.push(misses(case, |r| scene.closest(r).is_some()));
+        }
         #[cfg(feature = "tinybvh")]
         {
             let tiny = crate::tinybvh::TinyScene::new(&m.positions, &m.indices)?;
@@ -101,6 +109,8 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             format!("{name}: {n} misses of {rays} rays that must hit ({share:.3} %){mark}")
         })
         .collect();
+    #[cfg(feature = "embree4")]
+    let md = format!("Embree 4: {} (`RT_EMBREE4`).\n\n{md}", crate::embree4::version()?);
     let body = format!(
         "Rays that must hit a closed mesh (each aimed exactly at a vertex or a shared edge, its line through the solid; `rt_benches::watertight`), counted as misses when a query reports no hit. rt's kernels are all checked by `cargo test -p rt-benches --test watertight`. tinybvh rejects a triangle whose determinant is below an absolute 10⁻⁶ (its source), so small meshes are missed whole; double hits (two triangles reporting one crossing) are not counted, since closest-hit queries do not show them.\n\n{md}"
     );
