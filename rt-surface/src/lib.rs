@@ -65,6 +65,8 @@ extern crate alloc;
 #[cfg(feature = "std")]
 extern crate std;
 
+#[cfg(feature = "std")]
+pub mod cast;
 #[cfg(feature = "io")]
 pub mod io;
 mod math;
@@ -73,6 +75,8 @@ pub mod render;
 #[cfg(feature = "std")]
 pub mod scene;
 
+#[cfg(feature = "std")]
+pub use cast::RayCaster;
 pub use mesh::{Mesh, MeshError};
 #[cfg(feature = "std")]
 pub use render::{AnswerCountError, AnsweredOcclusion, RecordOcclusion};
