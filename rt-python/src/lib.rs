@@ -10,6 +10,7 @@
 //! an abort.
 
 mod bricks;
+mod cast;
 mod composite;
 mod optics;
 mod surface;
@@ -34,6 +35,7 @@ fn _rtvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(optics::bos, m)?)?;
     m.add_function(wrap_pyfunction!(optics::focusing, m)?)?;
     m.add_class::<surface::PyScene>()?;
+    m.add_class::<cast::PyRayMesh>()?;
     m.add_function(wrap_pyfunction!(composite::composite, m)?)?;
     m.add_function(wrap_pyfunction!(composite::composite_comm, m)?)?;
     m.add_function(wrap_pyfunction!(bricks::brick_box, m)?)?;

@@ -79,18 +79,27 @@ impl RayCaster {
     /// Every surface crossing along each ray, nearest first, at most
     /// `most` a ray: `(ray index, hit)`, in the rays' order. A ray that
     /// crosses at a shared edge or vertex crosses once there (the hit is
-    /// one of the triangles that meet there), so a ray through a closed
-    /// mesh crosses it an even number of times.
+    /// the nearest of the triangles that meet there; the others, whose
+    /// points agree with it within rounding, are skipped), so a ray
+    /// through a closed mesh crosses it an even number of times. Two
+    /// surfaces closer than 16 ulps of the coordinates count once.
     #[must_use]
     pub fn all(&self, rays: &[Ray], most: usize) -> Vec<(u32, Hit)> {
         let view = self.bvh.as_ref();
         let per_ray = map(rays, |r| {
-            let mut hits = Vec::new();
+            let mut hits: Vec<Hit> = Vec::new();
             let mut ray = *r;
-            while hits.len() < most {
+            // Each step moves past one hit; a crossing met again (its
+            // other triangles) is skipped, so this bounds the steps too.
+            for _ in 0..most.saturating_mul(8).saturating_add(64) {
+                if hits.len() >= most {
+                    break;
+                }
                 let Some(h) = view.closest_hit(&ray) else { break };
-                hits.push(h);
-                // Past this crossing: the next representable parameter.
+                if !hits.last().is_some_and(|last| same_crossing(last, &h)) {
+                    hits.push(h);
+                }
+                // Past this hit: the next representable parameter.
                 ray.t_min = h.t.next_up();
                 if ray.t_min > ray.t_max {
                     break;
@@ -104,6 +113,19 @@ impl RayCaster {
         }
         out
     }
+}
+
+/// Whether `b` is the crossing `a` already is: another triangle at a
+/// shared edge or vertex, whose point differs by rounding only. Their
+/// barycentrics round apart too, so the bound is the points' own error
+/// bounds (four times over) and 16 ulps of the larger coordinate: two
+/// surfaces closer than that count as one crossing.
+fn same_crossing(a: &Hit, b: &Hit) -> bool {
+    let gap = (a.position - b.position).abs();
+    let scale = a.position.abs().max_element().max(b.position.abs().max_element());
+    let bound =
+        (a.position_error + b.position_error) * 4.0 + Vec3::splat(scale * 16.0 * f32::EPSILON);
+    gap.cmple(bound).all()
 }
 
 /// `f` of every ray, in order (over rayon's threads with `parallel`).

@@ -135,3 +135,26 @@ fn a_caster_saved_as_bytes_answers_alike_and_bad_bytes_are_refused() {
     nan[0] = Vec3::NAN;
     assert!(RayCaster::new(&nan, &tris).is_err());
 }
+
+#[test]
+fn rays_through_shared_edges_and_vertices_cross_once_there() {
+    // Aimed at the centre through each vertex and each edge's midpoint:
+    // in and out, each often at another shared edge or vertex, where two
+    // or more triangles report distances a rounding apart.
+    let (p, tris) = mesh();
+    let caster = RayCaster::new(&p, &tris).unwrap();
+    let mut targets = p.clone();
+    for t in &tris {
+        for k in 0..3 {
+            targets.push((p[t[k] as usize] + p[t[(k + 1) % 3] as usize]) * 0.5);
+        }
+    }
+    let rays: Vec<Ray> = targets.iter().map(|&v| Ray::new(v * 3.0, -v)).collect();
+    assert!(caster.any(&rays).iter().all(|&a| a));
+    let mut count = vec![0usize; rays.len()];
+    for (i, _) in caster.all(&rays, 16) {
+        count[i as usize] += 1;
+    }
+    let odd: Vec<_> = count.iter().enumerate().filter(|(_, c)| **c != 2).collect();
+    assert!(odd.is_empty(), "{} of {} rays not crossing twice: {odd:?}", odd.len(), rays.len());
+}

@@ -12,6 +12,8 @@
   ``record`` for a camera sensor's counts.
 - Surfaces: ``Scene`` with meshes coloured by a scalar, sphere glyphs and
   tubes, rendered by ``Scene.render`` into premultiplied RGBA and depth.
+- Rays at meshes: ``RayMesh`` (first hit, any hit, every crossing of
+  batches of rays; trimesh's ``mesh.ray`` names), watertight.
 - Compositing: ``composite`` (images in one process) and
   ``composite_mpi`` (one image per MPI rank, through an ``mpi4py``
   communicator), sort-last by depth.
@@ -75,6 +77,7 @@ from ._surface import (
     _material,
     _paint_args,
 )
+from ._rays import RayHits, RayMesh
 from ._bricks import bos_pieces, brick_box, focusing_pieces, schlieren_pieces
 from ._composite import _ABANDONED_SENDS, _image_pair, _Mpi4pyComm, composite, composite_mpi
 from ._image import _srgb8, save_png, to_gray8, to_srgb8
@@ -89,6 +92,8 @@ __all__ = [
     "Mesh",
     "Optics",
     "ProgressCallback",
+    "RayHits",
+    "RayMesh",
     "RtvisWarning",
     "Scene",
     "Volume",
