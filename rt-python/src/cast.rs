@@ -20,15 +20,24 @@ pub(crate) struct PyRayMesh {
     caster: RayCaster,
 }
 
-/// Rows of an `(n, 3)` float32 array as vectors.
+/// Rows of an `(n, 3)` float32 array as vectors (a C-contiguous one read
+/// as one slice).
 fn rows(a: &PyReadonlyArray2<'_, f32>) -> Vec<Vec3> {
-    a.as_array().rows().into_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect()
+    match a.as_slice() {
+        Ok(flat) => flat.chunks_exact(3).map(Vec3::from_slice).collect(),
+        Err(_) => a.as_array().rows().into_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect(),
+    }
 }
 
 /// Rays from `origins` along `directions` (same length, checked by the
 /// caller), over `[0, ∞)`.
 fn rays(origins: &PyReadonlyArray2<'_, f32>, directions: &PyReadonlyArray2<'_, f32>) -> Vec<Ray> {
     rows(origins).into_iter().zip(rows(directions)).map(|(o, d)| Ray::new(o, d)).collect()
+}
+
+/// The triangle each hit is on; −1 for a miss.
+fn triangles(hits: &[Option<Hit>]) -> Array1<i64> {
+    hits.iter().map(|h| h.map_or(-1, |h| i64::from(h.prim))).collect()
 }
 
 type Hits<'py> = (
@@ -43,7 +52,7 @@ type Hits<'py> = (
 fn columns<'py>(py: Python<'py>, hits: &[Option<Hit>]) -> PyResult<Hits<'py>> {
     let n = hits.len();
     let t: Array1<f32> = hits.iter().map(|h| h.map_or(f32::INFINITY, |h| h.t)).collect();
-    let tri: Array1<i64> = hits.iter().map(|h| h.map_or(-1, |h| i64::from(h.prim))).collect();
+    let tri = triangles(hits);
     let uv: Vec<f32> =
         hits.iter().flat_map(|h| h.map_or([f32::NAN; 2], |h| h.uv.to_array())).collect();
     let at: Vec<f32> =
@@ -109,6 +118,19 @@ impl PyRayMesh {
         let rays = rays(&origins, &directions);
         let hits = py.detach(|| self.caster.first(&rays));
         columns(py, &hits)
+    }
+
+    /// The triangle each ray hits first (−1: none), without the rest.
+    fn first_triangle<'py>(
+        &self,
+        py: Python<'py>,
+        origins: PyReadonlyArray2<'py, f32>,
+        directions: PyReadonlyArray2<'py, f32>,
+    ) -> Bound<'py, PyArray1<i64>> {
+        let rays = rays(&origins, &directions);
+        let hits = py.detach(|| self.caster.nearest(&rays));
+        let tri: Array1<i64> = hits.iter().map(|h| h.map_or(-1, |h| i64::from(h.1))).collect();
+        tri.into_pyarray(py)
     }
 
     /// Whether each ray hits anything.

@@ -69,6 +69,15 @@ impl RayCaster {
         map(rays, |r| view.closest_hit(r))
     }
 
+    /// The distance and triangle of each ray's first hit, without the
+    /// rest of [`RayCaster::first`]'s record (cheaper: no point, normal
+    /// or barycentrics).
+    #[must_use]
+    pub fn nearest(&self, rays: &[Ray]) -> Vec<Option<(f32, u32)>> {
+        let view = self.bvh.as_ref();
+        map(rays, |r| view.closest_t(r).map(|h| (h.t, h.prim)))
+    }
+
     /// Whether each ray hits anything within its `[t_min, t_max]`.
     #[must_use]
     pub fn any(&self, rays: &[Ray]) -> Vec<bool> {

@@ -71,6 +71,8 @@ fn first_hits_are_the_brute_force_nearest_triangle() {
         }
     }
     assert!(hit > 1000, "only {hit} hits");
+    let nearest = caster.nearest(&rays);
+    assert!(nearest.iter().zip(&hits).all(|(n, h)| *n == h.map(|h| (h.t, h.prim))));
     let any = caster.any(&rays);
     assert!(any.iter().zip(&hits).all(|(a, h)| *a == h.is_some()));
 }

@@ -107,7 +107,9 @@ class RayMesh:
 
     def intersects_first(self, ray_origins: ArrayLike, ray_directions: ArrayLike) -> NDArray[np.int64]:
         """The triangle each ray hits first; -1 where it misses."""
-        return self.first_hit(ray_origins, ray_directions).triangle
+        o, d = _rays(ray_origins, ray_directions)
+        tri: NDArray[np.int64] = self._m.first_triangle(o, d)
+        return tri
 
     def intersects_any(self, ray_origins: ArrayLike, ray_directions: ArrayLike) -> NDArray[np.bool_]:
         """Whether each ray hits the mesh (its any-hit query: faster than

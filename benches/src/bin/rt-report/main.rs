@@ -15,6 +15,7 @@
 //! cargo run --release -p rt-benches --bin rt-report -- unstructured [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- distributed [--quick]
 //! cargo run --release -p rt-benches --bin rt-report -- gl [--quick]         # needs xvfb-run, cc, glxgears
+//! cargo run --release -p rt-benches --bin rt-report -- python [--quick]     # needs RT_PYTHON with rtvis, trimesh, embreex
 //! cargo run --release -p rt-benches --bin rt-report -- all [--quick]   # + index.md
 //! ```
 // A std-only tool crate: the no_std import lints guard the libraries.
@@ -33,6 +34,7 @@ mod gl_programs;
 mod grin;
 mod noise;
 mod octree;
+mod python;
 mod render;
 mod schlieren;
 mod timing;
@@ -119,8 +121,10 @@ const USAGE: &str = "usage: rt-report [AREA ...] [--quick]
 Writes tables, CSV files and plots under target/rt-report/.
 AREA: traversal, watertight, grin, octree, schlieren, noise, bos, focusing, render,
 composite, unstructured, distributed (none or
-`all`: every one of these, plus target/rt-report/index.md), or gl (rt-gl
-against Mesa; needs xvfb-run, cc and glxgears; not part of `all`).
+`all`: every one of these, plus target/rt-report/index.md), gl (rt-gl
+against Mesa; needs xvfb-run, cc and glxgears) or python (rtvis.RayMesh
+against embreex; needs RT_PYTHON with rtvis, trimesh and embreex); these
+two are not part of `all`.
 --quick: smaller problems, fewer repetitions (checks the pipeline, not the
 targets).
 
@@ -197,8 +201,9 @@ fn main() -> ExitCode {
             "unstructured" => unstructured::run(&dir, quick),
             "distributed" => distributed::run(&dir, quick),
             "gl" => gl::run(&dir, quick),
+            "python" => python::run(&dir, quick),
             other => Err(format!(
-                "unknown area `{other}` (known: traversal, watertight, grin, octree, schlieren, noise, bos, focusing, render, composite, unstructured, distributed, gl, all)"
+                "unknown area `{other}` (known: traversal, watertight, grin, octree, schlieren, noise, bos, focusing, render, composite, unstructured, distributed, gl, python, all)"
             )),
         };
         match result {
