@@ -35,9 +35,9 @@ fn rays(origins: &PyReadonlyArray2<'_, f32>, directions: &PyReadonlyArray2<'_, f
     rows(origins).into_iter().zip(rows(directions)).map(|(o, d)| Ray::new(o, d)).collect()
 }
 
-/// The triangle each hit is on; −1 for a miss.
-fn triangles(hits: &[Option<Hit>]) -> Array1<i64> {
-    hits.iter().map(|h| h.map_or(-1, |h| i64::from(h.prim))).collect()
+/// Triangle indices as numpy takes them; −1 for a miss.
+fn triangles(hits: impl Iterator<Item = Option<u32>>) -> Array1<i64> {
+    hits.map(|h| h.map_or(-1, i64::from)).collect()
 }
 
 type Hits<'py> = (
@@ -52,7 +52,7 @@ type Hits<'py> = (
 fn columns<'py>(py: Python<'py>, hits: &[Option<Hit>]) -> PyResult<Hits<'py>> {
     let n = hits.len();
     let t: Array1<f32> = hits.iter().map(|h| h.map_or(f32::INFINITY, |h| h.t)).collect();
-    let tri = triangles(hits);
+    let tri = triangles(hits.iter().map(|h| h.map(|h| h.prim)));
     let uv: Vec<f32> =
         hits.iter().flat_map(|h| h.map_or([f32::NAN; 2], |h| h.uv.to_array())).collect();
     let at: Vec<f32> =
@@ -129,8 +129,7 @@ impl PyRayMesh {
     ) -> Bound<'py, PyArray1<i64>> {
         let rays = rays(&origins, &directions);
         let hits = py.detach(|| self.caster.nearest(&rays));
-        let tri: Array1<i64> = hits.iter().map(|h| h.map_or(-1, |h| i64::from(h.1))).collect();
-        tri.into_pyarray(py)
+        triangles(hits.iter().map(|h| h.map(|h| h.1))).into_pyarray(py)
     }
 
     /// Whether each ray hits anything.
