@@ -37,6 +37,7 @@ mod octree;
 mod python;
 mod render;
 mod schlieren;
+mod schlieren_dense;
 mod timing;
 #[cfg(feature = "tinybvh")]
 mod tinybvh;
