@@ -235,42 +235,15 @@ fn catmull_rom(s: &Samples<'_>, dims: [usize; 3], b: [isize; 3], f: [f64; 3]) ->
     };
     let (wx, wy, wz) = (w(f[0]), w(f[1]), w(f[2]));
     let (dx, dy, dz) = (dw(f[0]), dw(f[1]), dw(f[2]));
-    let [nx, ny, nz] = dims.map(|n| n as isize);
-    let inside =
-        b[0] >= 1 && b[1] >= 1 && b[2] >= 1 && b[0] + 2 < nx && b[1] + 2 < ny && b[2] + 2 < nz;
-    // The 4³ stencil: straight from the data inside the grid, through
-    // the ghost-sample rule next to a face.
-    let mut st = [[[0.0f64; 4]; 4]; 4];
-    if inside {
-        let (sy, sz) = (s.dims[0], s.dims[0] * s.dims[1]);
-        let base = s.index([b[0] - 1, b[1] - 1, b[2] - 1].map(|v| v as usize));
-        for (k, plane) in st.iter_mut().enumerate() {
-            for (j, row) in plane.iter_mut().enumerate() {
-                let r = base + j * sy + k * sz;
-                for (i, v) in row.iter_mut().enumerate() {
-                    *v = f64::from(s.data[r + i]);
-                }
-            }
-        }
-    } else {
-        for (k, plane) in st.iter_mut().enumerate() {
-            for (j, row) in plane.iter_mut().enumerate() {
-                for (i, v) in row.iter_mut().enumerate() {
-                    *v = s.at(
-                        dims,
-                        [b[0] + i as isize - 1, b[1] + j as isize - 1, b[2] + k as isize - 1],
-                    );
-                }
-            }
-        }
-    }
+    let st = stencil_4x4x4(s, dims, b);
     // Separable: contract along x (value and x-derivative per row),
     // then y, then z — 4³ samples in ~200 flops instead of ~700.
     let dot = |w: &[f64; 4], v: &[f64; 4]| w[0] * v[0] + w[1] * v[1] + w[2] * v[2] + w[3] * v[3];
     let (mut v, mut gx, mut gy, mut gz) = (0.0, 0.0, 0.0, 0.0);
-    for (k, plane) in st.iter().enumerate() {
+    for (k, plane) in st.chunks_exact(16).enumerate() {
         let (mut a, mut ax) = ([0.0; 4], [0.0; 4]);
-        for (j, row) in plane.iter().enumerate() {
+        for (j, row) in plane.chunks_exact(4).enumerate() {
+            let row: &[f64; 4] = row.try_into().expect("rows of 4");
             a[j] = dot(&wx, row);
             ax[j] = dot(&dx, row);
         }
@@ -281,4 +254,108 @@ fn catmull_rom(s: &Samples<'_>, dims: [usize; 3], b: [isize; 3], f: [f64; 3]) ->
         gx += wz[k] * cx;
     }
     (v, DVec3::new(gx, gy, gz))
+}
+
+/// The 4³ samples `b − 1 … b + 2` the Catmull–Rom stencil at `b` reads,
+/// x fastest (`i + 4j + 16k`), ghost samples included: the same values as
+/// [`Samples::at`] gives one by one. Next to a face the stored samples are
+/// loaded with their indices clamped into the grid and the ghost rule is
+/// then applied along each axis in turn (`s₋₁ = 2s₀ − s₁`,
+/// `s_n = 2s_{n−1} − s_{n−2}`; a one-sample axis repeats it, as the
+/// clamped loads already do): the rule is linear per axis, so this is
+/// `at`'s recursion done for the whole block at once, 64 loads instead of
+/// up to 64 recursive lookups. Every sample it loads lies in the
+/// [`footprint`].
+#[inline]
+fn stencil_4x4x4(s: &Samples<'_>, dims: [usize; 3], b: [isize; 3]) -> [f64; 64] {
+    let mut st = [0.0f64; 64];
+    let n = dims.map(|n| n as isize);
+    let inside = (0..3).all(|a| b[a] >= 1 && b[a] + 2 < n[a]);
+    if inside {
+        let (sy, sz) = (s.dims[0], s.dims[0] * s.dims[1]);
+        let base = s.index([b[0] - 1, b[1] - 1, b[2] - 1].map(|v| v as usize));
+        for (k, plane) in st.chunks_exact_mut(16).enumerate() {
+            for (j, row) in plane.chunks_exact_mut(4).enumerate() {
+                let r = base + j * sy + k * sz;
+                for (i, v) in row.iter_mut().enumerate() {
+                    *v = f64::from(s.data[r + i]);
+                }
+            }
+        }
+        return st;
+    }
+    let clamped = |a: usize| [0, 1, 2, 3].map(|o| (b[a] + o - 1).clamp(0, n[a] - 1) as usize);
+    let (ix, iy, iz) = (clamped(0), clamped(1), clamped(2));
+    for (k, &gk) in iz.iter().enumerate() {
+        for (j, &gj) in iy.iter().enumerate() {
+            for (i, &gi) in ix.iter().enumerate() {
+                st[i + 4 * j + 16 * k] = f64::from(s.data[s.index([gi, gj, gk])]);
+            }
+        }
+    }
+    let stride = [1, 4, 16];
+    for a in 0..3 {
+        if n[a] < 2 {
+            continue;
+        }
+        // `b[a]` is in `0 ..= n − 2`, so only offset 0 (below) or 3
+        // (above) can be a ghost, and its edge and inner samples are in
+        // the block: positions 1, 2 below; 2, 1 above.
+        for (o, edge, inner) in [(0, 1, 2), (3, 2, 1)] {
+            let g = b[a] + o as isize - 1;
+            if g >= 0 && g < n[a] {
+                continue;
+            }
+            let others: [usize; 2] = match a {
+                0 => [4, 16],
+                1 => [1, 16],
+                _ => [1, 4],
+            };
+            for p in 0..4 {
+                for q in 0..4 {
+                    let at = |t: usize| p * others[0] + q * others[1] + t * stride[a];
+                    st[at(o)] = 2.0 * st[at(edge)] - st[at(inner)];
+                }
+            }
+        }
+    }
+    st
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The block loader gives, sample for sample and bit for bit, what the
+    /// ghost rule of [`Samples::at`] gives, on every axis length from one
+    /// sample up (one and two samples: every offset a ghost or a repeat)
+    /// and at every base a stencil can have.
+    #[test]
+    fn the_block_equals_the_ghost_rule_sample_by_sample() {
+        for dims in [[1, 2, 3], [2, 1, 5], [3, 4, 2], [5, 5, 5], [2, 2, 2], [1, 1, 1]] {
+            let len = dims.iter().product::<usize>();
+            let data: alloc::vec::Vec<f32> =
+                (0..len).map(|i| 1.0 + ((i as f32) * 0.77).sin() * 0.3).collect();
+            let s = Samples { data: &data, lo: [0; 3], dims };
+            let bases = |n: usize| 0..(n as isize - 1).max(1);
+            for bz in bases(dims[2]) {
+                for by in bases(dims[1]) {
+                    for bx in bases(dims[0]) {
+                        let b = [bx, by, bz];
+                        let st = stencil_4x4x4(&s, dims, b);
+                        for k in 0..4 {
+                            for j in 0..4 {
+                                for i in 0..4 {
+                                    let idx = [b[0] + i - 1, b[1] + j - 1, b[2] + k - 1];
+                                    let want = s.at(dims, idx);
+                                    let got = st[(i + 4 * j + 16 * k) as usize];
+                                    assert_eq!(got.to_bits(), want.to_bits(), "{dims:?} {idx:?}");
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
 }

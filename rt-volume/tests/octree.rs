@@ -245,3 +245,101 @@ fn beam_mask_rejects_bad_windows_and_other_fields() {
     assert!(mask.clear_at(o).is_some());
     assert_eq!(trace_beam(&f, &tree, &mask, o, DVec3::Z, &zero), Err(TraceError::InvalidParams));
 }
+
+/// A 40³ field disturbed everywhere: a sum of plane waves.
+fn waves(interp: Interp) -> GridField {
+    let n = 40;
+    let h = 1.0 / n as f64;
+    let origin = DVec3::splat(0.5 * h);
+    let mut data = Vec::with_capacity(n * n * n);
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                let p = origin + DVec3::new(i as f64, j as f64, k as f64) * h;
+                let v = 1.0
+                    + 1e-3 * (17.0 * p.x + 5.0 * p.z).sin()
+                    + 7e-4 * (11.0 * p.y - 13.0 * p.z + 0.3).cos()
+                    + 5e-4 * (23.0 * p.x + 19.0 * p.y).sin();
+                data.push(v as f32);
+            }
+        }
+    }
+    GridField::new(Grid::new([n; 3], origin, DVec3::splat(h), data).unwrap(), interp, 1.0).unwrap()
+}
+
+/// Where no node is smooth enough to cross, skipping must not change a
+/// ray at all: the octree's trace equals the plain trace bit for bit,
+/// evaluations and steps included, with either interpolant and any
+/// fixed-step or adaptive scheme (the dense path asks the octree once,
+/// then integrates the whole ray).
+#[test]
+fn a_dense_field_is_traced_exactly_as_without_the_octree() {
+    for interp in [Interp::Trilinear, Interp::CatmullRom] {
+        let f = waves(interp);
+        let tree = build_octree(&f).unwrap();
+        for params in [
+            TraceParams { max_step: 0.05, ..TraceParams::fixed(Method::Symplectic, 0.05) },
+            TraceParams::fixed(Method::Rk4, 0.025),
+            TraceParams { max_step: 0.025, ..TraceParams::accurate() },
+        ] {
+            for i in 0..20 {
+                let t = f64::from(i);
+                let o = DVec3::new(0.1 + 0.04 * t, 0.9 - 0.035 * t, -0.3);
+                let d = DVec3::new(0.1 * (0.7 * t).sin(), 0.1 * (1.3 * t).cos(), 1.0);
+                let plain = trace(&f, o, d, &params).unwrap();
+                let skipping = trace_skipping(&f, &tree, o, d, &params, 1e-9).unwrap();
+                assert_eq!(skipping, plain, "{interp:?} {:?} ray {i}", params.method);
+                assert_eq!(skipping.stats.skipped, 0);
+            }
+        }
+    }
+}
+
+/// [`Octree::rough_run`] against a fine walk along the same line: every
+/// brick before the distance it returns is rough, the one at it smooth
+/// (or the line has left the cells when it says `+∞`).
+#[test]
+fn a_rough_run_ends_where_a_fine_walk_meets_a_smooth_brick() {
+    let f = blobs(&[(0.3, 0.4, 0.5, 2e-3, 0.05), (0.7, 0.6, 0.4, 1e-3, 0.04)]);
+    let tree = build_octree(&f).unwrap();
+    let cells = 39.0;
+    let tol = 2e-6;
+    let mut finite = 0;
+    for i in 0..200 {
+        let t = f64::from(i);
+        let p = [
+            (0.37 * t).fract() * cells,
+            (0.61 * t + 0.2).fract() * cells,
+            (0.13 * t + 0.7).fract() * cells,
+        ];
+        let dir = DVec3::new((1.7 * t).sin(), (2.3 * t).cos(), (0.9 * t).sin() - 0.2).normalize();
+        let ds = (dir * 40.0).to_array();
+        let run = tree.rough_run(p, ds, tol);
+        let at = |s: f64| [0, 1, 2].map(|a| p[a] + s * ds[a]);
+        let smooth = |q: [f64; 3]| tree.smooth_node(q, tol).is_some();
+        if tree.brick_of(p).is_some_and(|_| smooth(p)) {
+            assert_eq!(run, 0.0, "smooth at the start, ray {i}");
+            continue;
+        }
+        // Walk in steps of 1e-3 of a cell, staying off brick faces by
+        // checking just before and just after the answer.
+        let step = 1e-3 / 40.0;
+        let end = if run.is_finite() { run - step } else { 10.0 };
+        let mut s = 0.0;
+        while s < end {
+            let q = at(s);
+            if tree.brick_of(q).is_none() {
+                break;
+            }
+            assert!(!smooth(q), "ray {i}: smooth at {s} before the run's end {run}");
+            s += step;
+        }
+        if run.is_finite() {
+            finite += 1;
+            assert!(smooth(at(run + step)), "ray {i}: rough just after the run's end {run}");
+        } else {
+            assert!(tree.brick_of(at(s)).is_none() || s >= end, "ray {i}: never left the cells");
+        }
+    }
+    assert!(finite > 10, "the field must have runs that end: {finite}");
+}

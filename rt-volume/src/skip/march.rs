@@ -6,7 +6,7 @@ use glam::DVec3;
 use super::{Octree, OctreeError};
 use crate::{
     GridField, TraceError, TraceParams, TraceResult,
-    trace::{Skip, trace_impl},
+    trace::{Offer, Skip, trace_impl},
 };
 
 /// An octree over a gridded field's samples, bounding the field's own
@@ -72,7 +72,7 @@ pub fn trace_skipping(
             let p0 = (x - o) * inv_h;
             let clamp = |p: DVec3| [0, 1, 2].map(|a| p[a].clamp(0.0, cells[a]));
             if rough.is_some() && tree.brick_of(clamp(p0)) == rough {
-                return None;
+                return Offer::None;
             }
             let ds = d.normalize() * inv_h;
             let inv = ds.recip();
@@ -134,8 +134,18 @@ pub fn trace_skipping(
                     break;
                 }
             }
+            if t == 0.0 {
+                // Rough where the ray is: integrate across the run of
+                // bricks too rough for the budget left that the straight
+                // line crosses (the budget only shrinks, so they stay
+                // rough), not asking at every step of a dense field.
+                return match tree.rough_run(clamp(p0), ds.to_array(), budget - spent) {
+                    0.0 => Offer::None,
+                    run => Offer::IntegrateFor(run),
+                };
+            }
             spent += bound;
-            (t > 0.0).then(|| Skip {
+            Offer::Skip(Skip {
                 len: t,
                 bound: bound / n_min,
                 n: value.filter(|_| uniform).map(f64::from),

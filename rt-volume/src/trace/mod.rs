@@ -19,6 +19,7 @@
 mod eval;
 mod params;
 mod path_state;
+mod run;
 mod schemes;
 mod walk;
 
@@ -27,7 +28,7 @@ pub use path_state::PathState;
 #[cfg(test)]
 pub(crate) use schemes::A;
 pub use walk::{Begin, Leg, trace, trace_begin, trace_leg, trace_visiting};
-pub(crate) use walk::{Skip, check_params, trace_impl};
+pub(crate) use walk::{Offer, Skip, check_params, trace_impl};
 
 #[cfg(test)]
 mod tests {

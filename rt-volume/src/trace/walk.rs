@@ -3,6 +3,7 @@
 use glam::DVec3;
 
 use super::eval::{Eval, State};
+use super::run::{RunLimits, leapfrog_run};
 use super::schemes::{adaptive_step, fixed_step, land};
 use super::{Exit, Method, PathState, TraceError, TraceParams, TraceResult, TraceStats};
 use crate::{Bounds, IndexField};
@@ -21,7 +22,7 @@ pub fn trace<F: IndexField>(
     direction: DVec3,
     params: &TraceParams,
 ) -> Result<TraceResult, TraceError> {
-    trace_impl(field, origin, direction, params, |_, _| None, |_| {})
+    trace_impl(field, origin, direction, params, |_, _| Offer::IntegrateFor(f64::INFINITY), |_| {})
 }
 
 /// [`trace`], calling `visit(x)` at the end of every step inside the
@@ -36,7 +37,21 @@ pub fn trace_visiting<F: IndexField>(
     params: &TraceParams,
     visit: impl FnMut(DVec3),
 ) -> Result<TraceResult, TraceError> {
-    trace_impl(field, origin, direction, params, |_, _| None, visit)
+    trace_impl(field, origin, direction, params, |_, _| Offer::IntegrateFor(f64::INFINITY), visit)
+}
+
+/// What a skip oracle answers before a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Offer {
+    /// No straight move here: integrate the step.
+    None,
+    /// No straight move for at least this arc length ahead (what lies
+    /// there along the straight line is too rough to skip, and stays so):
+    /// integrate, and do not ask again until the ray has gone that far.
+    /// Asking later than needed only integrates more; never a wrong skip.
+    IntegrateFor(f64),
+    /// Move straight.
+    Skip(Skip),
 }
 
 /// A straight move offered by a skip oracle.
@@ -77,10 +92,11 @@ pub(super) fn unit(v: DVec3) -> DVec3 {
 /// over this (see [`TraceParams::max_step`]).
 const ADAPTIVE_STEPS_PER_CHORD: f64 = 24.0;
 
-/// [`trace`] with a skip oracle: before each step, `skip(x, T)` may return
+/// [`trace`] with a skip oracle: before each step, `skip(x, T)` may offer
 /// a [`Skip`]: the ray then moves `len` straight along `d̂ = T/|T|` (`T`
 /// keeps its direction, optical path by the trapezoid rule), and `bound`
-/// is added to [`TraceStats::skip_bound`].
+/// is added to [`TraceStats::skip_bound`]; or [`Offer::IntegrateFor`], and
+/// is not asked again until the ray has gone that far.
 ///
 /// Every tracer is this: [`trace_begin`] and one leg that owns all space
 /// (the code a distributed trace runs leg by leg).
@@ -89,7 +105,7 @@ pub(crate) fn trace_impl<F: IndexField>(
     origin: DVec3,
     direction: DVec3,
     params: &TraceParams,
-    skip: impl FnMut(DVec3, DVec3) -> Option<Skip>,
+    skip: impl FnMut(DVec3, DVec3) -> Offer,
     visit: impl FnMut(DVec3),
 ) -> Result<TraceResult, TraceError> {
     match trace_begin(field.bounds(), field.ambient(), origin, direction, params)? {
@@ -187,7 +203,7 @@ pub fn trace_leg<F: IndexField>(
     owns: impl Fn(DVec3) -> bool,
 ) -> Result<Leg, TraceError> {
     check_params(params)?;
-    leg(field, state, params, owns, |_, _| None, |_| {})
+    leg(field, state, params, owns, |_, _| Offer::IntegrateFor(f64::INFINITY), |_| {})
 }
 
 /// [`trace_leg`] with a skip oracle and a visitor (see [`trace_impl`]).
@@ -196,7 +212,7 @@ pub(super) fn leg<F: IndexField>(
     state: PathState,
     params: &TraceParams,
     owns: impl Fn(DVec3) -> bool,
-    mut skip: impl FnMut(DVec3, DVec3) -> Option<Skip>,
+    mut skip: impl FnMut(DVec3, DVec3) -> Offer,
     mut visit: impl FnMut(DVec3),
 ) -> Result<Leg, TraceError> {
     if !owns(state.y.x) {
@@ -217,7 +233,7 @@ pub(super) fn leg<F: IndexField>(
         let d = y.t;
         let offer = skip(y.x, d);
         let n0 = match offer {
-            Some(Skip { n: Some(n), .. }) => n,
+            Offer::Skip(Skip { n: Some(n), .. }) => n,
             _ => ev.n(y.x)?.0,
         };
         first = Some(offer);
@@ -236,6 +252,8 @@ pub(super) fn leg<F: IndexField>(
     let limit = params.max_length;
     // The index at `y.x` where a skip knew it without evaluating.
     let mut known_here = None;
+    // The arc length before which the oracle is not asked again.
+    let mut ask_from = f64::NEG_INFINITY;
     let exit = loop {
         if !owns(y.x) {
             // Hand the ray on before the step: the state is whole.
@@ -253,9 +271,28 @@ pub(super) fn leg<F: IndexField>(
         }
         let offer = match first.take() {
             Some(offer) => offer,
+            None if y.s < ask_from => {
+                if params.method == Method::Symplectic {
+                    let lim = RunLimits {
+                        h,
+                        limit,
+                        until_s: ask_from,
+                        max_steps: params.max_steps,
+                        owns: &owns,
+                    };
+                    if leapfrog_run(&mut ev, &mut y, &mut stats, &lim, &mut visit)? > 0 {
+                        known_here = None;
+                        continue;
+                    }
+                }
+                Offer::None
+            }
             None => skip(y.x, y.t),
         };
-        if let Some(Skip { len, bound, n: known }) = offer {
+        if let Offer::IntegrateFor(len) = offer {
+            ask_from = y.s + len;
+        }
+        if let Offer::Skip(Skip { len, bound, n: known }) = offer {
             let d = unit(y.t);
             // A skip that would leave the bounds stops on their surface;
             // one that would pass the arc-length limit stops there.
