@@ -261,10 +261,10 @@ pub fn dense_flow(n: usize, seed: u64) -> Grid {
     let mul = |a: (f64, f64), b: (f64, f64)| (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0);
     let width = 1.5 * h;
     let mut data = Vec::with_capacity(n * n * n);
-    for k in 0..n {
-        for j in 0..n {
+    for (k, zk) in tz.iter().enumerate() {
+        for (j, yj) in ty.iter().enumerate() {
             let yz: Vec<(f64, f64)> = (0..modes.len())
-                .map(|m| mul(mul((modes[m].2.cos(), modes[m].2.sin()), ty[j][m]), tz[k][m]))
+                .map(|m| mul(mul((modes[m].2.cos(), modes[m].2.sin()), yj[m]), zk[m]))
                 .collect();
             for (i, row) in tx.iter().enumerate() {
                 let p = origin + DVec3::new(i as f64, j as f64, k as f64) * h;
