@@ -75,7 +75,6 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
             rows.push((name.to_string(), film.emitted, secs, e, samples.spread()));
         }
     }
-    std::fs::write(dir.join("schlieren.csv"), &csv).map_err(|e| e.to_string())?;
     let series: Vec<Series> = [
         ("original", "original: Euler, 1-voxel steps"),
         ("rt", "rt: leapfrog + octree, 1 voxel"),
@@ -157,6 +156,11 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     let (dense_md, dense_verdicts) = crate::schlieren_dense::table(&dense, size, photons);
     md.push_str(&dense_md);
     verdicts.extend(dense_verdicts);
+    for r in &dense {
+        writeln!(csv, "dense128,rt-{},{},{:.4},{:e}", r.interp, r.photons, r.seconds, r.rmse)
+            .unwrap();
+    }
+    std::fs::write(dir.join("schlieren.csv"), &csv).map_err(|e| e.to_string())?;
     writeln!(md, "\nwrote {}", dir.join("schlieren.csv").display()).unwrap();
     Ok(Section {
         title: format!(
