@@ -14,6 +14,17 @@ fn blobs(spec: &[(f64, f64, f64, f64, f64)]) -> GridField {
 
 /// [`blobs`] with either interpolant.
 fn blobs_with(spec: &[(f64, f64, f64, f64, f64)], interp: Interp) -> GridField {
+    field_40(interp, |p| {
+        let mut v = 1.0;
+        for &(x, y, z, amp, s) in spec {
+            v += amp * (-(p - DVec3::new(x, y, z)).length_squared() / (2.0 * s * s)).exp();
+        }
+        v
+    })
+}
+
+/// `value(p)` sampled at the cell centres of a 40³ grid on the unit cube.
+fn field_40(interp: Interp, value: impl Fn(DVec3) -> f64) -> GridField {
     let n = 40;
     let h = 1.0 / n as f64;
     let origin = DVec3::splat(0.5 * h);
@@ -21,12 +32,7 @@ fn blobs_with(spec: &[(f64, f64, f64, f64, f64)], interp: Interp) -> GridField {
     for k in 0..n {
         for j in 0..n {
             for i in 0..n {
-                let p = origin + DVec3::new(i as f64, j as f64, k as f64) * h;
-                let mut v = 1.0;
-                for &(x, y, z, amp, s) in spec {
-                    v += amp * (-(p - DVec3::new(x, y, z)).length_squared() / (2.0 * s * s)).exp();
-                }
-                data.push(v as f32);
+                data.push(value(origin + DVec3::new(i as f64, j as f64, k as f64) * h) as f32);
             }
         }
     }
@@ -248,23 +254,11 @@ fn beam_mask_rejects_bad_windows_and_other_fields() {
 
 /// A 40³ field disturbed everywhere: a sum of plane waves.
 fn waves(interp: Interp) -> GridField {
-    let n = 40;
-    let h = 1.0 / n as f64;
-    let origin = DVec3::splat(0.5 * h);
-    let mut data = Vec::with_capacity(n * n * n);
-    for k in 0..n {
-        for j in 0..n {
-            for i in 0..n {
-                let p = origin + DVec3::new(i as f64, j as f64, k as f64) * h;
-                let v = 1.0
-                    + 1e-3 * (17.0 * p.x + 5.0 * p.z).sin()
-                    + 7e-4 * (11.0 * p.y - 13.0 * p.z + 0.3).cos()
-                    + 5e-4 * (23.0 * p.x + 19.0 * p.y).sin();
-                data.push(v as f32);
-            }
-        }
-    }
-    GridField::new(Grid::new([n; 3], origin, DVec3::splat(h), data).unwrap(), interp, 1.0).unwrap()
+    field_40(interp, |p| {
+        1.0 + 1e-3 * (17.0 * p.x + 5.0 * p.z).sin()
+            + 7e-4 * (11.0 * p.y - 13.0 * p.z + 0.3).cos()
+            + 5e-4 * (23.0 * p.x + 19.0 * p.y).sin()
+    })
 }
 
 /// Where no node is smooth enough to cross, skipping must not change a
