@@ -141,6 +141,11 @@ seconds,photons_per_s,cells_crossed,cells_per_s: a 256x256 beam through
 the N = 64 mesh, 6.29M tetrahedra, one thread and all cores;
 cells_crossed = sum of TraceStats::steps, the tetrahedra crossed).
 
+schlieren writes schlieren.csv (case,method,photons,seconds,rmse: the
+sparse 128^3 field's sweep, and the dense 128^3 flow rendered as
+`rt schlieren` renders it, one thread, rmse against RK4 at h/4 from the
+same photons) and the dense flow itself, dense_flow_128.json + .raw.
+
 distributed writes distributed.csv (kind,ranks,seconds,items_sent,
 bytes_sent,messages,identical_to_single: surfaces with shadows and AO and
 the blast wave's knife-edge schlieren on 1, 2, 4, 8, 16 in-process ranks;
