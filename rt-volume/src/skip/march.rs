@@ -52,8 +52,8 @@ pub fn trace_skipping(
     let n_min = f64::from(tree.root().min).max(1e-6);
     let tiny = 1e-9 * h.min_element();
     let cells = (DVec3::from(g.dims().map(|d| d as f64)) - 1.0).to_array();
-    // The brick last found too rough to skip: the steps inside it ask no
-    // further (the budget only shrinks, so it stays too rough).
+    // The brick last found too rough to skip: a chain stops there without
+    // asking the tree again (the budget only shrinks, so it stays rough).
     let mut rough: Option<[usize; 3]> = None;
     // The skip bound spent so far, in `max|∇n| · length` (times `n_min`,
     // radians).
@@ -71,9 +71,6 @@ pub fn trace_skipping(
             // `t` the world length moved.
             let p0 = (x - o) * inv_h;
             let clamp = |p: DVec3| [0, 1, 2].map(|a| p[a].clamp(0.0, cells[a]));
-            if rough.is_some() && tree.brick_of(clamp(p0)) == rough {
-                return Offer::None;
-            }
             let ds = d.normalize() * inv_h;
             let inv = ds.recip();
             let (mut t, mut bound) = (0.0, 0.0);

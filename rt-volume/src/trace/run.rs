@@ -60,7 +60,6 @@ pub(super) fn leapfrog_run<F: IndexField, O: Fn(DVec3) -> bool>(
         };
         visit(y.x);
         stats.steps += 1;
-        stats.error_estimate += 0.0;
         stats.invariant_drift = stats.invariant_drift.max((y.t.length() - n_b).abs());
         stats.field_evals = ev.evals;
         taken += 1;

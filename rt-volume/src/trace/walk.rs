@@ -22,7 +22,7 @@ pub fn trace<F: IndexField>(
     direction: DVec3,
     params: &TraceParams,
 ) -> Result<TraceResult, TraceError> {
-    trace_impl(field, origin, direction, params, |_, _| Offer::IntegrateFor(f64::INFINITY), |_| {})
+    trace_impl(field, origin, direction, params, never_skip, |_| {})
 }
 
 /// [`trace`], calling `visit(x)` at the end of every step inside the
@@ -37,7 +37,12 @@ pub fn trace_visiting<F: IndexField>(
     params: &TraceParams,
     visit: impl FnMut(DVec3),
 ) -> Result<TraceResult, TraceError> {
-    trace_impl(field, origin, direction, params, |_, _| Offer::IntegrateFor(f64::INFINITY), visit)
+    trace_impl(field, origin, direction, params, never_skip, visit)
+}
+
+/// The oracle of a trace without skipping: never asked after the entry.
+fn never_skip(_: DVec3, _: DVec3) -> Offer {
+    Offer::IntegrateFor(f64::INFINITY)
 }
 
 /// What a skip oracle answers before a step.
@@ -203,7 +208,7 @@ pub fn trace_leg<F: IndexField>(
     owns: impl Fn(DVec3) -> bool,
 ) -> Result<Leg, TraceError> {
     check_params(params)?;
-    leg(field, state, params, owns, |_, _| Offer::IntegrateFor(f64::INFINITY), |_| {})
+    leg(field, state, params, owns, never_skip, |_| {})
 }
 
 /// [`trace_leg`] with a skip oracle and a visitor (see [`trace_impl`]).

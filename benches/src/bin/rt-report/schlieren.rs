@@ -21,7 +21,8 @@ use crate::{
 
 const FILM: usize = 128;
 
-fn rmse(a: &Film, b: &Film) -> f64 {
+/// Image rmse of `a` against `b`, normalized to the background.
+pub(crate) fn rmse(a: &Film, b: &Film) -> f64 {
     let (x, y) = (a.normalized(), b.normalized());
     let s: f64 = x.iter().zip(&y).map(|(p, q)| f64::from(p[0] - q[0]).powi(2)).sum();
     (s / x.len() as f64).sqrt()

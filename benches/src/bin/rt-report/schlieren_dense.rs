@@ -12,7 +12,10 @@ use rt_benches::scenes::{DENSE_GRID, dense_flow};
 use rt_photo::{Film, Medium, Samples as Gas, SchlierenOptions, SchlierenSetup};
 use rt_volume::{Interp, Method, TraceParams, trace};
 
-use crate::timing::{Samples, time};
+use crate::{
+    schlieren::rmse,
+    timing::{Samples, time},
+};
 
 /// One interpolant's row.
 pub(crate) struct DenseRow {
@@ -23,12 +26,6 @@ pub(crate) struct DenseRow {
     pub(crate) rmse: f64,
     pub(crate) steps_per_photon: f64,
     pub(crate) evals_per_photon: f64,
-}
-
-fn rmse(a: &Film, b: &Film) -> f64 {
-    let (x, y) = (a.normalized(), b.normalized());
-    let s: f64 = x.iter().zip(&y).map(|(p, q)| f64::from(p[0] - q[0]).powi(2)).sum();
-    (s / x.len() as f64).sqrt()
 }
 
 /// The dense rows (trilinear, Catmull–Rom) at `size` pixels and `photons`
