@@ -16,6 +16,13 @@
 //! directions, along the axes, shallow (lines within 2 % of the
 //! inradius of the surface), and from the surface inwards; at scales from
 //! 10⁻⁸ to 10⁸.
+//!
+//! The same rays also count double hits ([`at_aims`]): where a line
+//! crosses the surface once, at the shared edge or vertex it is aimed at,
+//! an all-hits query that reports two triangles there counts the crossing
+//! twice, and an inside/outside test by the parity of crossings fails.
+
+use std::collections::HashMap;
 
 use glam::Vec3;
 use rt_core::Ray;
@@ -31,10 +38,30 @@ pub struct Case {
     pub mesh: Mesh,
     /// Rays that must hit it.
     pub rays: Vec<Ray>,
+    /// Where each ray crosses the surface at the point it is aimed at.
+    pub aims: Vec<Aim>,
+}
+
+/// The point of the surface a ray of the suite is aimed at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aim {
+    /// The point (for a ray from the surface, its origin).
+    pub point: Vec3,
+    /// How far along the ray from the point a hit still is the crossing
+    /// there: a twentieth of the inradius (of a cell, for the height
+    /// field) over the cosine to the most grazing face that meets there,
+    /// at most a quarter of the chord through a convex mesh. So it is far
+    /// above the rounding of `t` (which grows as the ray grazes: for a ray
+    /// along a needle, a thousandfold) and below the distance to the next
+    /// crossing.
+    pub window: f32,
 }
 
 /// The scales every mesh is tried at.
 pub const SCALES: [f32; 5] = [1e-8, 1e-4, 1.0, 1e4, 1e8];
+
+/// Vertices along each side of the height field.
+const FIELD: u32 = 48;
 
 /// The suite: each mesh at each of [`SCALES`], with `targets` vertices
 /// and edge midpoints aimed at per mesh.
@@ -44,22 +71,44 @@ pub fn suite(targets: usize) -> Vec<Case> {
         ("icosphere", icosphere(3), true),
         ("sliver cube", sliver_cube(1000), true),
         ("needle bipyramid", needles(256, 1e-4), true),
-        ("height field", terrain(48), false),
+        ("height field", terrain(FIELD), false),
     ];
     let mut cases = Vec::new();
     for (name, mesh, convex) in meshes {
-        let rays = if convex { convex_rays(&mesh, targets) } else { field_rays(&mesh, targets) };
+        let (aimed, near) = if convex {
+            (convex_rays(&mesh, targets), 0.05 * inradius(&mesh))
+        } else {
+            // The height field's cells are 2 / (n − 1) wide.
+            (field_rays(&mesh, targets), 0.05 * 2.0 / (FIELD - 1) as f32)
+        };
+        let faces = faces_at(&mesh);
+        let window = |r: &Ray, t: Vec3| {
+            let d = r.direction.normalize();
+            let cos = faces[&t.to_array().map(f32::to_bits)]
+                .iter()
+                .map(|n| n.dot(d).abs())
+                .fold(1.0, f32::min);
+            let window = near / cos.max(1e-6);
+            // A quarter of the chord, where the faces there graze more
+            // than the line does (a ray along a needle, at its apex).
+            if convex { window.min(0.25 * chord(&mesh, r) as f32) } else { window }
+        };
+        let aimed: Vec<(Ray, Aim)> =
+            aimed.iter().map(|&(r, t)| (r, Aim { point: t, window: window(&r, t) })).collect();
         for s in SCALES {
             let scaled = Mesh {
                 positions: mesh.positions.iter().map(|p| *p * s).collect(),
                 indices: mesh.indices.clone(),
             };
-            let rays = rays
+            let (rays, aims) = aimed
                 .iter()
-                .map(|r| Ray { origin: r.origin * s, ..*r })
-                .filter(|r| r.origin.is_finite())
-                .collect();
-            cases.push(Case { name: format!("{name} ×{s:e}"), mesh: scaled, rays });
+                .map(|(r, aim)| {
+                    let aim = Aim { point: aim.point * s, window: aim.window * s };
+                    (Ray { origin: r.origin * s, ..*r }, aim)
+                })
+                .filter(|(r, _)| r.origin.is_finite())
+                .unzip();
+            cases.push(Case { name: format!("{name} ×{s:e}"), mesh: scaled, rays, aims });
         }
     }
     cases
@@ -138,6 +187,39 @@ fn centroid(m: &Mesh) -> Vec3 {
     (lo + hi) * 0.5
 }
 
+/// The unit normals of the triangles that meet at each vertex and edge
+/// midpoint of `m` (keyed by the point's bits).
+fn faces_at(m: &Mesh) -> HashMap<[u32; 3], Vec<Vec3>> {
+    let mut faces: HashMap<[u32; 3], Vec<Vec3>> = HashMap::new();
+    for t in &m.indices {
+        let [a, b, c] = t.map(|i| m.positions[i as usize]);
+        let n = (b - a).cross(c - a).normalize();
+        for p in [a, b, c, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5] {
+            faces.entry(p.to_array().map(f32::to_bits)).or_default().push(n);
+        }
+    }
+    faces
+}
+
+/// The length of the chord of the convex, outward-facing mesh `m` on the
+/// line of `r` (in units of its direction's length): between the last
+/// face plane it enters and the first it leaves, in f64.
+fn chord(m: &Mesh, r: &Ray) -> f64 {
+    let (o, d) = (r.origin.as_dvec3(), r.direction.as_dvec3());
+    let (mut enter, mut leave) = (f64::NEG_INFINITY, f64::INFINITY);
+    for t in &m.indices {
+        let [a, b, c] = t.map(|i| m.positions[i as usize].as_dvec3());
+        let n = (b - a).cross(c - a);
+        let (along, to) = (n.dot(d), n.dot(a - o));
+        if along < 0.0 {
+            enter = enter.max(to / along);
+        } else if along > 0.0 {
+            leave = leave.min(to / along);
+        }
+    }
+    leave - enter
+}
+
 /// Vertices and edge midpoints of `m`, `count` of them spread evenly.
 fn targets(m: &Mesh, count: usize) -> Vec<Vec3> {
     let mut all: Vec<Vec3> = m.positions.clone();
@@ -174,24 +256,30 @@ impl Random {
     }
 }
 
-/// Rays through the targets of a convex mesh and a point inside it.
-fn convex_rays(m: &Mesh, count: usize) -> Vec<Ray> {
+/// The inradius of a convex mesh about its centroid: the distance to the
+/// nearest face plane.
+fn inradius(m: &Mesh) -> f32 {
     let c = centroid(m);
-    // The inradius about the centroid: the nearest face plane.
-    let inradius = m
-        .indices
+    m.indices
         .iter()
         .map(|t| {
             let [a, b, d] = t.map(|i| m.positions[i as usize]);
             (b - a).cross(d - a).normalize().dot(a - c).abs()
         })
-        .fold(f32::INFINITY, f32::min);
+        .fold(f32::INFINITY, f32::min)
+}
+
+/// Rays through the targets of a convex mesh and a point inside it, each
+/// with its target.
+fn convex_rays(m: &Mesh, count: usize) -> Vec<(Ray, Vec3)> {
+    let c = centroid(m);
+    let inradius = inradius(m);
     let (lo, hi) = m.bounds();
     let far = 3.0 * (hi - lo).length();
     let mut random = Random(0x5eed);
     let mut rays = Vec::new();
     // Outside, on the line through `t` along `d`: the ray aimed at `t`.
-    let aimed = |t: Vec3, d: Vec3| Ray::new(t - d * far, d);
+    let aimed = |t: Vec3, d: Vec3| (Ray::new(t - d * far, d), t);
     for t in targets(m, count) {
         for _ in 0..2 {
             let p = c + random.ball() * (0.5 * inradius);
@@ -211,23 +299,36 @@ fn convex_rays(m: &Mesh, count: usize) -> Vec<Ray> {
         rays.push(aimed(t, (p - t).normalize()));
         // From the surface, inwards.
         let p = c + random.ball() * (0.5 * inradius);
-        rays.push(Ray::new(t, (p - t).normalize()));
+        rays.push((Ray::new(t, (p - t).normalize()), t));
     }
     rays
 }
 
 /// Rays from above through the targets of a height field over
-/// `[-1, 1]²` (those within 0.95 of its centre on both axes).
-fn field_rays(m: &Mesh, count: usize) -> Vec<Ray> {
+/// `[-1, 1]²` (those within 0.95 of its centre on both axes), each with
+/// its target: straight down, and tilted where a tilt crosses the
+/// surface there once.
+fn field_rays(m: &Mesh, count: usize) -> Vec<(Ray, Vec3)> {
+    let faces = faces_at(m);
     let mut random = Random(0xf1e1d);
     let mut rays = Vec::new();
     for t in targets(m, count * 2) {
         if t.x.abs() > 0.95 || t.z.abs() > 0.95 {
             continue;
         }
-        let tilted = Vec3::new(random.next() - 0.5, -1.0, random.next() - 0.5).normalize();
-        for d in [-Vec3::Y, tilted] {
-            rays.push(Ray::new(t - d * 4.0, d));
+        // A tilted line crosses the surface once at `t` only if it passes
+        // every face there from the same side, at an angle: else it may
+        // touch the surface there, and cross it twice or not at all.
+        let at = &faces[&t.to_array().map(f32::to_bits)];
+        let once = |d: Vec3| {
+            let cos: Vec<f32> = at.iter().map(|n| n.dot(d)).collect();
+            cos.iter().all(|c| *c > 0.2) || cos.iter().all(|c| *c < -0.2)
+        };
+        let tilted = (0..16)
+            .map(|_| Vec3::new(random.next() - 0.5, -1.0, random.next() - 0.5).normalize())
+            .find(|d| once(*d));
+        for d in core::iter::once(-Vec3::Y).chain(tilted) {
+            rays.push((Ray::new(t - d * 4.0, d), t));
         }
     }
     rays
@@ -236,4 +337,56 @@ fn field_rays(m: &Mesh, count: usize) -> Vec<Ray> {
 /// How many of `case`'s rays `hits` says miss.
 pub fn misses(case: &Case, mut hits: impl FnMut(&Ray) -> bool) -> usize {
     case.rays.iter().filter(|r| !hits(r)).count()
+}
+
+/// What an all-hits query reported where the suite's rays cross the
+/// surface at the point they are aimed at.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AtAims {
+    /// Rays counted: those aimed at their point from outside (a ray from
+    /// the surface is left out: whether a hit at `t = 0` counts is a
+    /// convention, not a crack).
+    pub rays: usize,
+    /// Rays with no hit at their point (a crack).
+    pub missed: usize,
+    /// Rays with hits on two or more triangles at their point, where the
+    /// line crosses the surface once (a double count: an inside/outside
+    /// test by counting crossings gets it wrong).
+    pub doubled: usize,
+}
+
+impl core::ops::AddAssign for AtAims {
+    fn add_assign(&mut self, o: Self) {
+        self.rays += o.rays;
+        self.missed += o.missed;
+        self.doubled += o.doubled;
+    }
+}
+
+/// Counts, over `case`'s rays aimed from outside, the crossings that
+/// `all_hits` (every hit along a ray as `(t, triangle)`, in any order)
+/// reports at the aimed point: the hits within its [`Aim::window`], one a
+/// triangle (a triangle reported twice, as a BVH with split references
+/// may, is one).
+pub fn at_aims(case: &Case, mut all_hits: impl FnMut(&Ray) -> Vec<(f32, u32)>) -> AtAims {
+    let mut out = AtAims::default();
+    for (r, aim) in case.rays.iter().zip(&case.aims) {
+        let d = r.direction.as_dvec3();
+        let t_aim = (aim.point.as_dvec3() - r.origin.as_dvec3()).dot(d) / d.length_squared();
+        let window = f64::from(aim.window) / d.length();
+        if t_aim <= window {
+            continue;
+        }
+        let mut there: Vec<u32> = all_hits(r)
+            .into_iter()
+            .filter(|&(t, _)| (f64::from(t) - t_aim).abs() <= window)
+            .map(|(_, prim)| prim)
+            .collect();
+        there.sort_unstable();
+        there.dedup();
+        out.rays += 1;
+        out.missed += usize::from(there.is_empty());
+        out.doubled += usize::from(there.len() > 1);
+    }
+    out
 }

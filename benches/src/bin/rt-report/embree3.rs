@@ -21,6 +21,16 @@ impl EmbreeScene {
     /// the optimizations that cost accuracy (its robust box test and a
     /// watertight triangle test, as rt always does).
     pub(crate) fn new(positions: &[Vec3], indices: &[[u32; 3]], robust: bool) -> Self {
+        Self::build(positions, indices, robust, false)
+    }
+
+    /// A scene for [`EmbreeScene::all_hits`]: its geometry records and
+    /// rejects every hit ([`crate::filter`]).
+    pub(crate) fn recording(positions: &[Vec3], indices: &[[u32; 3]], robust: bool) -> Self {
+        Self::build(positions, indices, robust, true)
+    }
+
+    fn build(positions: &[Vec3], indices: &[[u32; 3]], robust: bool, record: bool) -> Self {
         let device: &'static Device = Box::leak(Box::new(Device::new()));
         let mut mesh = TriangleMesh::unanimated(device, indices.len(), positions.len());
         {
@@ -34,6 +44,17 @@ impl EmbreeScene {
             }
         }
         let mut geom = Geometry::Triangle(mesh);
+        if record {
+            /// The shared filter, under the crate's declaration of its type.
+            unsafe extern "C" fn record(args: *const embree::sys::RTCFilterFunctionNArguments) {
+                // SAFETY: Embree 3's arguments, laid out as `FilterArgs`.
+                unsafe { crate::filter::record_and_reject(args.cast()) }
+            }
+            // SAFETY: the live geometry, not yet committed.
+            unsafe {
+                embree::sys::rtcSetGeometryIntersectFilterFunction(geom.handle(), Some(record))
+            };
+        }
         geom.commit();
         let scene: &'static mut Scene<'static> = Box::leak(Box::new(Scene::new(device)));
         scene.attach_geometry(geom);
@@ -65,6 +86,14 @@ impl EmbreeScene {
 }
 
 impl EmbreeScene {
+    /// Every hit along `r`, `(t, primitive)` in the order Embree found
+    /// them (a scene made by [`EmbreeScene::recording`]).
+    pub(crate) fn all_hits(&self, ctx: &mut IntersectContext, r: &rt_core::Ray) -> Vec<(f32, u32)> {
+        crate::filter::collect(|| {
+            self.closest(ctx, r);
+        })
+    }
+
     /// Whether anything is hit (`rtcOccluded1`, which sets `tfar` to −∞
     /// when it finds a hit).
     pub(crate) fn occluded(&self, ctx: &mut IntersectContext, r: &rt_core::Ray) -> bool {

@@ -15,6 +15,8 @@ use std::sync::OnceLock;
 
 use libloading::Library;
 
+use crate::filter::FilterArgs;
+
 type Device = *mut c_void;
 type Scene = *mut c_void;
 type Geometry = *mut c_void;
@@ -69,6 +71,7 @@ struct Api {
     release_geometry: unsafe extern "C" fn(Geometry),
     commit_scene: unsafe extern "C" fn(Scene),
     intersect1: unsafe extern "C" fn(Scene, *mut RtcRayHit, *mut c_void),
+    set_filter: unsafe extern "C" fn(Geometry, Option<unsafe extern "C" fn(*const FilterArgs)>),
     occluded1: unsafe extern "C" fn(Scene, *mut RtcRay, *mut c_void),
     device: Device,
     /// Kept loaded for the process's life.
@@ -121,6 +124,7 @@ fn load() -> Result<Api, String> {
             release_geometry: f!("rtcReleaseGeometry"),
             commit_scene: f!("rtcCommitScene"),
             intersect1: f!("rtcIntersect1"),
+            set_filter: f!("rtcSetGeometryIntersectFilterFunction"),
             occluded1: f!("rtcOccluded1"),
             device,
             _lib: lib,
@@ -155,6 +159,25 @@ impl Embree4Scene {
         indices: &[[u32; 3]],
         robust: bool,
     ) -> Result<Self, String> {
+        Self::build(positions, indices, robust, false)
+    }
+
+    /// A scene for [`Embree4Scene::all_hits`]: its geometry records and
+    /// rejects every hit ([`crate::filter`]).
+    pub(crate) fn recording(
+        positions: &[glam::Vec3],
+        indices: &[[u32; 3]],
+        robust: bool,
+    ) -> Result<Self, String> {
+        Self::build(positions, indices, robust, true)
+    }
+
+    fn build(
+        positions: &[glam::Vec3],
+        indices: &[[u32; 3]],
+        robust: bool,
+        record: bool,
+    ) -> Result<Self, String> {
         let api = api()?;
         // SAFETY: Embree allocates both buffers (padded for its loads) with
         // the counts given; each is written within them before commit.
@@ -177,6 +200,9 @@ impl Embree4Scene {
             }
             for (i, t) in indices.iter().enumerate() {
                 ib.add(i).write(*t);
+            }
+            if record {
+                (api.set_filter)(geom, Some(crate::filter::record_and_reject));
             }
             (api.commit_geometry)(geom);
             (api.attach)(scene, geom);
@@ -213,6 +239,14 @@ impl Embree4Scene {
         // SAFETY: a committed scene and a ray-hit laid out as RTCRayHit.
         unsafe { (self.api.intersect1)(self.scene, &mut rh, core::ptr::null_mut()) };
         (rh.geom_id != INVALID_GEOMETRY_ID).then_some((rh.ray.tfar, rh.prim_id))
+    }
+
+    /// Every hit along `r`, `(t, primitive)` in the order Embree found
+    /// them (a scene made by [`Embree4Scene::recording`]).
+    pub(crate) fn all_hits(&self, r: &rt_core::Ray) -> Vec<(f32, u32)> {
+        crate::filter::collect(|| {
+            self.closest(r);
+        })
     }
 
     /// Whether anything is hit (`tfar` set to −∞ on a hit).
