@@ -111,8 +111,8 @@ pub use focusing::{
     FocusingError, FocusingImages, FocusingRig, FocusingRigOptions, FocusingSchlieren, SourceGrid,
 };
 pub use schlieren::{
-    BenchError, Cutoff, CutoffError, CutoffParam, Film, FilmError, Filter, FilterImage, Mode,
-    Photon, Reconstruction, SchlierenBench, Weighting,
+    BatchTracer, BenchError, Cutoff, CutoffError, CutoffParam, Film, FilmError, Filter,
+    FilterImage, Mode, Photon, Reconstruction, SchlierenBench, Weighting,
 };
 pub use setup::{
     Axis, BosOptions, BosSetup, CutoffKind, FocusingOptions, FocusingSetup, MAX_APERTURE_SAMPLES,

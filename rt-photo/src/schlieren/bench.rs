@@ -191,6 +191,11 @@ pub struct SchlierenBench {
     pub params: TraceParams,
 }
 
+/// A tracer of many rays at once: `(origin, direction)` pairs in, their
+/// traces out in the same order ([`SchlierenBench::render_batched`]).
+pub type BatchTracer<'a> =
+    dyn FnMut(&[(DVec3, DVec3)]) -> Result<Vec<TraceResult>, TraceError> + 'a;
+
 /// Photons a sheet pass holds at once (56 bytes each: 117 MB); a larger
 /// lattice is traced and shared out in bands of rows.
 const SHEET_BAND_PHOTONS: usize = 1 << 21;
@@ -456,6 +461,62 @@ impl SchlierenBench {
         self.render_colored_with(&|o, d| tracer(o, d).map(|r| (r, [1.0; 3])), film, pass, seed)
     }
 
+    /// [`SchlierenBench::render_with`] with the pass's photons traced all at
+    /// once by `batch` (a GPU, say): it is handed every `(origin,
+    /// direction)` the pass emits, in no set order, and returns their
+    /// traces in the same order. The photons are then cut, carried to the
+    /// film and splatted exactly as `render_with` does with a tracer giving
+    /// those traces, so the image is the one it would make. (The pass is
+    /// walked twice on the host: once to list its photons, once to splat
+    /// them.)
+    ///
+    /// # Errors
+    /// As [`SchlierenBench::render`]; [`BenchError::Trace`] with `batch`'s
+    /// error, or [`TraceError::InvalidRay`] where it returns fewer traces
+    /// than photons. The film is unchanged then.
+    #[cfg(feature = "std")]
+    pub fn render_batched(
+        &self,
+        batch: &mut BatchTracer<'_>,
+        film: &mut Film,
+        pass: u64,
+        seed: u64,
+    ) -> Result<(), BenchError> {
+        use std::{collections::HashMap, sync::Mutex};
+        let key = |o: DVec3, d: DVec3| [o.x, o.y, o.z, d.x, d.y, d.z].map(f64::to_bits);
+        // The pass's photons: asked of a tracer that lists them and goes
+        // straight, on a scratch film.
+        let asked = Mutex::new(Vec::new());
+        let list = |o: DVec3, d: DVec3| {
+            asked.lock().map_err(|_| TraceError::InvalidRay)?.push((o, d));
+            Ok((
+                TraceResult {
+                    position: o,
+                    direction: d,
+                    optical_path: 0.0,
+                    exit: rt_volume::Exit::Missed,
+                    stats: Default::default(),
+                },
+                [1.0; 3],
+            ))
+        };
+        self.render_colored_with(&list, &mut film.clone(), pass, seed)?;
+        let mut asked =
+            asked.into_inner().map_err(|_| BenchError::Trace(TraceError::InvalidRay))?;
+        asked.sort_unstable_by_key(|&(o, d)| key(o, d));
+        asked.dedup_by_key(|&mut (o, d)| key(o, d));
+        let traced = batch(&asked).map_err(BenchError::Trace)?;
+        if traced.len() != asked.len() {
+            return Err(BenchError::Trace(TraceError::InvalidRay));
+        }
+        let found: HashMap<_, _> =
+            asked.iter().zip(traced).map(|(&(o, d), r)| (key(o, d), r)).collect();
+        let look_up = |o: DVec3, d: DVec3| {
+            found.get(&key(o, d)).map(|&r| (r, [1.0; 3])).ok_or(TraceError::InvalidRay)
+        };
+        self.render_colored_with(&look_up, film, pass, seed)
+    }
+
     /// Multifield: each photon also carries the colour `map(s̄)` of a
     /// second, scalar field, `s̄` its mean over the steps of the photon's
     /// bent path inside the volume, multiplied into its cutoff weight.
@@ -599,6 +660,29 @@ mod tests {
     use crate::{Filter, Weighting};
     use rt_volume::GaussianBump;
 
+    /// A 6 × 4 beam along +z into a bump at the origin, imaging its
+    /// mid-plane, 2 × 2 photons a pixel per pass.
+    fn bump_bench(
+        mode: Mode,
+        film_distance: f64,
+        reconstruction: Reconstruction,
+    ) -> SchlierenBench {
+        SchlierenBench {
+            center: DVec3::new(0.0, 0.0, -6.0),
+            direction: DVec3::Z,
+            u: DVec3::X,
+            width: 6.0,
+            height: 4.0,
+            image_plane: 6.0,
+            film_distance,
+            mode,
+            weighting: Weighting::Weight,
+            reconstruction,
+            strata: 2,
+            params: TraceParams::accurate(),
+        }
+    }
+
     /// The sheet traced and shared out in bands of a few rows is the
     /// sheet of one band, bit for bit (cells reach each pixel in the same
     /// order), photon counts included; a knife edge and a shadowgraph
@@ -610,20 +694,7 @@ mod tests {
         for (mode, film_distance) in
             [(Mode::Schlieren(knife), 0.0), (Mode::Schlieren(Cutoff::None), 900.0)]
         {
-            let bench = SchlierenBench {
-                center: DVec3::new(0.0, 0.0, -6.0),
-                direction: DVec3::Z,
-                u: DVec3::X,
-                width: 6.0,
-                height: 4.0,
-                image_plane: 6.0,
-                film_distance,
-                mode,
-                weighting: Weighting::Weight,
-                reconstruction: Reconstruction::Sheet,
-                strata: 2,
-                params: TraceParams::accurate(),
-            };
+            let bench = bump_bench(mode, film_distance, Reconstruction::Sheet);
             let tracer = |o, d| trace(&f, o, d, &bench.params).map(|r| (r, [1.0; 3]));
             let render = |band| {
                 let mut film = Film::new(30, 20, Filter::Tent).unwrap();
@@ -636,6 +707,41 @@ mod tests {
             for band in [62 * 2, 62 * 5, 62 * 7 + 3] {
                 assert_eq!(render(band), whole, "bands of {} rows", band / 62);
             }
+        }
+    }
+
+    /// Photons traced in one batch make the image the per-photon tracer
+    /// makes, bit for bit: splatted photons (box and tent) and the sheet,
+    /// a knife edge and interferometry, over two passes; a batch that
+    /// returns too few traces is an error and leaves the film as it was.
+    #[test]
+    fn a_batch_of_traces_makes_the_image_of_one_at_a_time() {
+        let f = GaussianBump::new(DVec3::ZERO, 2e-3, 1.0, 5.0);
+        let knife = Cutoff::KnifeEdge { angle: 0.3, offset: 0.0, f: 1.0, h: 1e-3 };
+        let fringes = Mode::Interferometry { lambda: 5e-4, n_ref: 1.0, fringe_spacing: None };
+        for (mode, reconstruction, filter) in [
+            (Mode::Schlieren(knife.clone()), Reconstruction::Photons, Filter::Box),
+            (Mode::Schlieren(knife.clone()), Reconstruction::Photons, Filter::Tent),
+            (Mode::Schlieren(knife), Reconstruction::Sheet, Filter::Tent),
+            (fringes, Reconstruction::Photons, Filter::Tent),
+        ] {
+            let bench = bump_bench(mode, 0.0, reconstruction);
+            let (mut one, mut all) =
+                (Film::new(24, 16, filter).unwrap(), Film::new(24, 16, filter).unwrap());
+            let mut batch = |rays: &[(DVec3, DVec3)]| {
+                rays.iter().map(|&(o, d)| trace(&f, o, d, &bench.params)).collect()
+            };
+            for pass in 0..2 {
+                bench.render(&f, &mut one, pass, 5).unwrap();
+                bench.render_batched(&mut batch, &mut all, pass, 5).unwrap();
+            }
+            assert_eq!(all, one, "{reconstruction:?}, {filter:?}");
+            let before = all.clone();
+            let mut short = |rays: &[(DVec3, DVec3)]| {
+                Ok(alloc::vec![trace(&f, rays[0].0, rays[0].1, &bench.params)?])
+            };
+            assert!(bench.render_batched(&mut short, &mut all, 2, 5).is_err());
+            assert_eq!(all, before);
         }
     }
 }

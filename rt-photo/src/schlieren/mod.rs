@@ -7,6 +7,6 @@ mod cutoff;
 mod film;
 mod sheet;
 
-pub use bench::{BenchError, Mode, Reconstruction, SchlierenBench, Weighting};
+pub use bench::{BatchTracer, BenchError, Mode, Reconstruction, SchlierenBench, Weighting};
 pub use cutoff::{Cutoff, CutoffError, CutoffParam, FilterImage};
 pub use film::{Film, FilmError, Filter, Photon};

@@ -214,16 +214,33 @@ impl SchlierenSetup {
         progress: &mut dyn FnMut(u64, u64),
         stop: &(dyn Fn() -> bool + Sync),
     ) -> Result<Film, SetupError> {
+        self.render_passes(progress, &mut |bench, film, pass| {
+            bench
+                .render_medium_until(medium, film, pass, seed, stop)
+                .map_err(|e| SetupError::stopped_or(stop, e))
+        })
+    }
+
+    /// The render's film, each pass added by `pass(bench, film, index)`
+    /// (the bench with the pass's lattice; e.g. traced on a GPU with the
+    /// same optics): what [`SchlierenSetup::render_until`] does with the
+    /// CPU's tracers. `progress(done, total)` after each pass, in photons.
+    ///
+    /// # Errors
+    /// A film that does not fit in memory; the first error of `pass`.
+    pub fn render_passes(
+        &self,
+        progress: &mut dyn FnMut(u64, u64),
+        pass: &mut dyn FnMut(&SchlierenBench, &mut Film, u64) -> Result<(), SetupError>,
+    ) -> Result<Film, SetupError> {
         let (w, h) = self.size;
         let mut film = Film::new(w, h, Filter::Tent)?;
         let (strata, passes) = lattice(self.options.photons);
         let bench = SchlierenBench { strata, ..self.bench.clone() };
         let per_pass = (w * h) as u64 * u64::from(strata * strata);
-        for pass in 0..passes {
-            bench
-                .render_medium_until(medium, &mut film, pass, seed, stop)
-                .map_err(|e| SetupError::stopped_or(stop, e))?;
-            progress(per_pass * (pass + 1), per_pass * passes);
+        for p in 0..passes {
+            pass(&bench, &mut film, p)?;
+            progress(per_pass * (p + 1), per_pass * passes);
         }
         Ok(film)
     }
