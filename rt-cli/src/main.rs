@@ -18,6 +18,8 @@ fn main() -> ExitCode {
         let at = info.location().map(|l| format!(" at {}:{}", l.file(), l.line()));
         eprintln!("rt: error: internal error{}: {line} (please report it)", at.unwrap_or_default());
     }));
+    // SAFETY: the first thing the program does: no other thread runs yet.
+    unsafe { rt_gpu::quiet_without_session() };
     let cli = rt_cli::Cli::parse();
     match rt_cli::run(cli) {
         Ok(()) => ExitCode::SUCCESS,

@@ -41,6 +41,30 @@ impl From<Samples> for rt_volume::Samples {
     }
 }
 
+/// Where the photons are traced.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum DeviceArg {
+    /// The CPU's cores (f64; the same image on every machine).
+    #[default]
+    Cpu,
+    /// The GPU (any Vulkan, Metal or DX12 driver; f32, within 1e-5 rms of
+    /// the CPU's image): grids with `--interp linear` only.
+    Gpu,
+    /// The GPU where there is one and it traces the volume, else the CPU;
+    /// the choice is printed.
+    Auto,
+}
+
+impl From<DeviceArg> for rt_gpu::Device {
+    fn from(d: DeviceArg) -> Self {
+        match d {
+            DeviceArg::Cpu => Self::Cpu,
+            DeviceArg::Gpu => Self::Gpu,
+            DeviceArg::Auto => Self::Auto,
+        }
+    }
+}
+
 /// How the field is interpolated between samples. Both take the fast
 /// path: the octree bounds either interpolant (rt-volume's `skip`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

@@ -15,7 +15,7 @@ use rt_volume::glam::DVec3;
 use crate::{
     figure::{self, Figure, Legend},
     image,
-    optics::{self, Axis, Interpolation, MeshOptions, Samples},
+    optics::{self, Axis, DeviceArg, Interpolation, MeshOptions, Samples},
     output::Outputs,
     parse, progress,
 };
@@ -123,6 +123,12 @@ pub struct Args {
     /// How an unstructured mesh is read and traced.
     #[command(flatten)]
     pub mesh: MeshOptions,
+    /// Where the photons are traced: `cpu` (the default: the same image on
+    /// every machine), `gpu` (grids with `--interp linear`; an error where
+    /// there is no GPU), `auto` (the GPU where it can, else the CPU; the
+    /// choice is printed).
+    #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
+    pub device: DeviceArg,
     /// Seed of every random choice: the same seed gives the same image.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -218,8 +224,20 @@ pub fn render(medium: &Medium, a: &Args) -> anyhow::Result<()> {
     }
     let (w, h) = setup.size;
     let bar = progress::bar((w * h) as u64 * traced_per_pixel(a.photons), "photons");
+    let chosen = rt_gpu::choose(a.device.into(), medium)?;
+    if a.device != DeviceArg::Cpu {
+        bar.suspend(|| eprintln!("rt: tracing on {}", chosen.describe()));
+    }
     let t = Instant::now();
-    let film = setup.render(medium, a.seed, &mut |done, _| bar.set_position(done))?;
+    let film = match &chosen {
+        rt_gpu::Chosen::Gpu(gpu) => {
+            let progress = &mut |done, _| bar.set_position(done);
+            rt_gpu::render_schlieren(gpu, &setup, medium, a.seed, progress, &|| false)?
+        }
+        rt_gpu::Chosen::Cpu(_) => {
+            setup.render(medium, a.seed, &mut |done, _| bar.set_position(done))?
+        }
+    };
     let seconds = t.elapsed().as_secs_f64();
     bar.finish_and_clear();
     let bench = &setup.bench;
