@@ -4,13 +4,19 @@
 //! (`rt_photo::SchlierenSetup`, `BosSetup`, `FocusingSetup`) as `rt
 //! schlieren`, `rt bos` and `rt focusing` set them up: the same defaults,
 //! the same automatic choices, the same image for the same options. The
-//! options are checked once, there.
+//! options are checked once, there. The schlieren bench's photons are
+//! traced on the device `device` names (`rt_gpu::choose`, as `rt
+//! schlieren --device`).
 
 use numpy::{
     IntoPyArray, PyArray2, PyArray3, PyReadonlyArray2,
     ndarray::{Array2, Array3, ArrayD},
 };
-use pyo3::{exceptions::PyMemoryError, prelude::*, types::PyDict};
+use pyo3::{
+    exceptions::{PyKeyboardInterrupt, PyMemoryError, PyRuntimeError, PyValueError},
+    prelude::*,
+    types::PyDict,
+};
 use rt_photo::{
     Airy, Axis, BackgroundChoice, BosOptions, BosRigOptions, BosSetup, Cutoff, CutoffKind,
     FocusingOptions, FocusingRigOptions, FocusingSetup, Mode, Reconstruction, SchlierenOptions,
@@ -131,7 +137,7 @@ fn chosen<'py>(py: Python<'py>, setup: &SchlierenSetup) -> PyResult<Bound<'py, P
 /// (`relative`: divided by the background's level).
 #[pyfunction]
 #[pyo3(name = "_optics")]
-#[pyo3(signature = (volume, cutoff_name, angle, f, h, radius, half_range, wavelength, fringe_spacing, film_distance, axis_name, size, photons, seed, estimator_name, output, progress=None))]
+#[pyo3(signature = (volume, cutoff_name, angle, f, h, radius, half_range, wavelength, fringe_spacing, film_distance, axis_name, size, photons, seed, estimator_name, output, progress=None, device_name="cpu"))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn optics<'py>(
     py: Python<'py>,
@@ -152,7 +158,18 @@ pub(crate) fn optics<'py>(
     estimator_name: &str,
     output: (bool, bool, bool, bool, bool),
     progress: Option<Py<PyAny>>,
+    device_name: &str,
 ) -> PyResult<Optics<'py>> {
+    let device = match device_name {
+        "cpu" => rt_gpu::Device::Cpu,
+        "gpu" => rt_gpu::Device::Gpu,
+        "auto" => rt_gpu::Device::Auto,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "device: expected \"cpu\", \"gpu\" or \"auto\", got {other:?}"
+            )));
+        }
+    };
     let options = SchlierenOptions {
         cutoff: cutoff(cutoff_name)?,
         angle,
@@ -170,12 +187,25 @@ pub(crate) fn optics<'py>(
     };
     let (rgb, wide, relative, want_deflection, want_phase) = output;
     let v = &volume.inner;
-    let (film, setup) = watched(py, progress, |w| -> Result<_, rt_photo::SetupError> {
-        let setup = SchlierenSetup::choose(v, &options)?;
-        let film = setup.render_until(v, seed, &mut |d, t| w.progress(d, t), &|| w.stopped())?;
-        Ok((film, setup))
+    let (film, setup, on) = watched(py, progress, |w| -> Result<_, Failed> {
+        let setup = SchlierenSetup::choose(v, &options).map_err(Failed::Setup)?;
+        let chosen = rt_gpu::choose(device, v).map_err(Failed::Gpu)?;
+        let film = match &chosen {
+            rt_gpu::Chosen::Gpu(gpu) => {
+                let (progress, stop) = (&mut |d, t| w.progress(d, t), &|| w.stopped());
+                rt_gpu::render_schlieren(gpu, &setup, v, seed, progress, stop)
+                    .map_err(Failed::Gpu)?
+            }
+            rt_gpu::Chosen::Cpu(_) => setup
+                .render_until(v, seed, &mut |d, t| w.progress(d, t), &|| w.stopped())
+                .map_err(Failed::Setup)?,
+        };
+        Ok((film, setup, chosen.describe()))
     })?
-    .map_err(setup_error)?;
+    .map_err(|e| match e {
+        Failed::Setup(e) => setup_error(e),
+        Failed::Gpu(e) => gpu_error(e),
+    })?;
     let (w, h) = (film.width(), film.height());
     let n = w * h;
     // Relative to the background, channel by channel, where it is not
@@ -215,7 +245,31 @@ pub(crate) fn optics<'py>(
         None
     };
     drop(film);
-    Ok((image, deflection, phase, chosen(py, &setup)?, setup.to_string(), setup.warning))
+    let said = match device {
+        rt_gpu::Device::Cpu => setup.to_string(),
+        _ => format!("{setup}; traced on {on}"),
+    };
+    Ok((image, deflection, phase, chosen(py, &setup)?, said, setup.warning))
+}
+
+/// Why a render on either device failed.
+enum Failed {
+    Setup(rt_photo::SetupError),
+    Gpu(rt_gpu::GpuError),
+}
+
+/// A GPU error as Python's: a medium or device the GPU cannot take is a
+/// `ValueError` (or `RuntimeError` where there is no adapter), a device
+/// failure a `RuntimeError`.
+fn gpu_error(e: rt_gpu::GpuError) -> PyErr {
+    use rt_gpu::GpuError as E;
+    match e {
+        E::Unsupported(_) | E::BadSettings | E::NonFinite { .. } | E::ZeroDirection { .. } => {
+            PyValueError::new_err(format!("rtvis: {e}"))
+        }
+        E::Stopped => PyKeyboardInterrupt::new_err("stopped"),
+        e => PyRuntimeError::new_err(format!("rtvis: {e}")),
+    }
 }
 
 /// Records an intensity image (1 = background) as a camera sensor would

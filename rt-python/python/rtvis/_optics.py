@@ -25,7 +25,7 @@ def _bench(volume: Union[Volume, Mesh], cutoff: str, *, angle: float = 0.0, f: f
            film_distance: Optional[float] = None, axis: str = "z", size: int = 512, photons: int = 16,
            seed: int = 1, estimator: str = "sheet",
            output: Tuple[bool, bool, bool, bool, bool] = (True, True, False, True, True),
-           progress: Union[None, bool, ProgressCallback] = None
+           progress: Union[None, bool, ProgressCallback] = None, device: str = "cpu"
            ) -> Tuple[NDArray[Any], Optional[NDArray[np.float32]], Optional[NDArray[np.float64]], Dict[str, Any], str]:
     """The bench's film: ``(image, deflection, phase, chosen, description)``;
     ``output = (rgb, float64, relative, deflection, phase)`` says what to
@@ -50,6 +50,7 @@ def _bench(volume: Union[Volume, Mesh], cutoff: str, *, angle: float = 0.0, f: f
         _str("estimator", estimator),
         cast(Tuple[bool, bool, bool, bool, bool], tuple(bool(o) for o in output)),
         _progress(progress, _NAMES.get(cutoff, "rtvis.schlieren")),
+        _str("device", device),
     )
     if warning is not None:
         import warnings
@@ -118,6 +119,7 @@ def schlieren(
     dtype: Any = np.float32,
     chosen: bool = False,
     progress: Union[None, bool, ProgressCallback] = None,
+    device: str = "cpu",
 ) -> Any:
     """Synthetic schlieren of ``volume``: a parallel beam along ``axis``
     through the whole volume, photons bent along curved paths by the
@@ -174,6 +176,13 @@ def schlieren(
         ``progress(done, total)`` (photons) on the calling thread.
         Ctrl-C stops the render within a fraction of a second and raises
         ``KeyboardInterrupt``.
+    device : "cpu", "gpu" or "auto"
+        Where the photons are traced: ``cpu`` (the default: the same image
+        on every machine), ``gpu`` (any Vulkan, Metal or DX12 driver, f32;
+        volumes with ``interpolation="linear"`` only, else ``ValueError``;
+        no adapter: ``RuntimeError``), ``auto`` (the GPU where it can,
+        else the CPU). With ``chosen=True`` the optics' description
+        names the device used.
 
     Returns
     -------
@@ -198,7 +207,7 @@ def schlieren(
     return _render(volume, cutoff, keywords, {}, fixed, deflection=deflection, dtype=dtype, chosen=chosen,
                    progress=progress, angle=angle, f=f, h=h, radius=radius, half_range=half_range,
                    film_distance=film_distance, axis=axis, size=size, photons=photons, seed=seed,
-                   estimator=estimator)
+                   estimator=estimator, device=device)
 
 
 def shadowgraph(
@@ -212,16 +221,17 @@ def shadowgraph(
     dtype: Any = np.float32,
     chosen: bool = False,
     progress: Union[None, bool, ProgressCallback] = None,
+    device: str = "cpu",
 ) -> Any:
     """Synthetic shadowgraph: no cutoff, the film ``distance`` metres
     behind the volume's mid-plane (default: automatic, the strongest
     contrast about 0.5). Returns the intensity relative to the undisturbed
     beam, (h, w) of ``dtype`` (and the deflection, and the chosen optics,
-    as :func:`schlieren`)."""
+    as :func:`schlieren`; ``device`` as there)."""
     keywords = ("distance", "axis", "size", "photons", "seed")
     return _render(volume, "none", keywords, {"film_distance": "distance"}, dict(axis=axis, seed=seed),
                    deflection=deflection, dtype=dtype, chosen=chosen, progress=progress,
-                   film_distance=distance, axis=axis, size=size, photons=photons, seed=seed)
+                   film_distance=distance, axis=axis, size=size, photons=photons, seed=seed, device=device)
 
 
 def interferogram(
@@ -237,6 +247,7 @@ def interferogram(
     dtype: Any = np.float32,
     chosen: bool = False,
     progress: Union[None, bool, ProgressCallback] = None,
+    device: str = "cpu",
 ) -> Any:
     """Synthetic interferogram: ``I = (1 + cos(φ + 2π x/Λ))/2`` with the
     phase ``φ = (2π/λ)·∫(n − n_ref) ds`` along each curved path (``n_ref``:
@@ -251,7 +262,7 @@ def interferogram(
     return _render(volume, "interferometry", keywords, {}, dict(axis=axis, seed=seed),
                    deflection=deflection, phase=phase, dtype=dtype, chosen=chosen, progress=progress,
                    wavelength=wavelength, fringe_spacing=fringe_spacing, axis=axis, size=size,
-                   photons=photons, seed=seed)
+                   photons=photons, seed=seed, device=device)
 
 
 def color_schlieren(
@@ -265,6 +276,7 @@ def color_schlieren(
     dtype: Any = np.float32,
     chosen: bool = False,
     progress: Union[None, bool, ProgressCallback] = None,
+    device: str = "cpu",
 ) -> Any:
     """Colour (rainbow) schlieren: a hue-wheel filter in the focal plane,
     hue = direction of the deflection, saturation = its size relative to
@@ -274,7 +286,7 @@ def color_schlieren(
     keywords = ("half_range", "axis", "size", "photons", "seed")
     return _render(volume, "color", keywords, {}, dict(axis=axis, seed=seed), deflection=deflection,
                    dtype=dtype, chosen=chosen, progress=progress, half_range=half_range, axis=axis,
-                   size=size, photons=photons, seed=seed)
+                   size=size, photons=photons, seed=seed, device=device)
 
 
 def record(image: ArrayLike, exposure: float = 10_000.0, full_well: float = 20_000.0, bits: int = 16,

@@ -35,7 +35,7 @@ def _read_mesh(path: Any, array: Optional[str], quantity: str, k: float, trace: 
 def _optics(volume: _Volume, cutoff_name: str, angle: float, f: float, h: Optional[float], radius: Optional[float],
             half_range: Optional[float], wavelength: float, fringe_spacing: Optional[float],
             film_distance: Optional[float], axis_name: str, size: int, photons: int, seed: int, estimator_name: str,
-            output: Tuple[bool, bool, bool, bool, bool], progress: _Progress = None
+            output: Tuple[bool, bool, bool, bool, bool], progress: _Progress = None, device_name: str = "cpu"
             ) -> Tuple[NDArray[Any], Optional[NDArray[np.float32]], Optional[NDArray[np.float64]], Dict[str, Any],
                        str, Optional[str]]: ...
 def _record(image: NDArray[np.float64], exposure: float, full_well: float, bits: int, shot_noise: bool,
