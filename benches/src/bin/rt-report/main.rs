@@ -28,6 +28,8 @@ mod distributed;
 mod embree3;
 #[cfg(feature = "embree4")]
 mod embree4;
+#[cfg(any(feature = "embree3", feature = "embree4"))]
+mod filter;
 mod focusing;
 mod gl;
 mod gl_programs;
@@ -152,6 +154,8 @@ the blast wave's knife-edge schlieren on 1, 2, 4, 8, 16 in-process ranks;
 items are occlusion rays or photons sent between ranks).";
 
 fn main() -> ExitCode {
+    // SAFETY: the first thing the program does: no other thread runs yet.
+    unsafe { rt_gpu::quiet_without_session() };
     let t0 = std::time::Instant::now();
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.iter().any(|a| a == "--help" || a == "-h") {

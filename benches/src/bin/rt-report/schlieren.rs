@@ -158,8 +158,7 @@ pub(crate) fn run(dir: &Path, quick: bool) -> Result<Section, String> {
     md.push_str(&dense_md);
     verdicts.extend(dense_verdicts);
     for r in &dense {
-        writeln!(csv, "dense128,rt-{},{},{:.4},{:e}", r.interp, r.photons, r.seconds, r.rmse)
-            .unwrap();
+        writeln!(csv, "dense128,{},{},{:.4},{:e}", r.interp, r.photons, r.seconds, r.rmse).unwrap();
     }
     std::fs::write(dir.join("schlieren.csv"), &csv).map_err(|e| e.to_string())?;
     writeln!(md, "\nwrote {}", dir.join("schlieren.csv").display()).unwrap();

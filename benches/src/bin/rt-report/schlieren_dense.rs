@@ -19,7 +19,10 @@ use crate::{
 
 /// One interpolant's row.
 pub(crate) struct DenseRow {
+    /// `rt-trilinear`, `rt-catmull-rom`, or `gpu-trilinear`.
     pub(crate) interp: &'static str,
+    /// Where it ran: `one CPU thread`, or the adapter's name.
+    pub(crate) on: String,
     pub(crate) photons: u64,
     pub(crate) seconds: f64,
     pub(crate) spread: f64,
@@ -36,7 +39,9 @@ pub(crate) fn rows(dir: &Path, size: u32, photons: u32) -> Result<Vec<DenseRow>,
     write_field(dir, &grid)?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().map_err(|e| e.to_string())?;
     let mut out = Vec::new();
-    for (name, interp) in [("trilinear", Interp::Trilinear), ("catmull-rom", Interp::CatmullRom)] {
+    for (name, interp) in
+        [("rt-trilinear", Interp::Trilinear), ("rt-catmull-rom", Interp::CatmullRom)]
+    {
         let medium =
             Medium::from_grid(grid.clone(), Gas::AIR, false, interp).map_err(|e| e.to_string())?;
         let options = SchlierenOptions { size, photons, ..SchlierenOptions::default() };
@@ -64,8 +69,46 @@ pub(crate) fn rows(dir: &Path, size: u32, photons: u32) -> Result<Vec<DenseRow>,
                 .map_err(|e| e.to_string())?;
         }
         let (steps, evals) = per_photon(&medium, &setup);
+        if interp == Interp::Trilinear {
+            // The same render with its photons traced on the GPU, where
+            // there is one (`rt schlieren --device gpu`).
+            match rt_gpu::Gpu::new() {
+                Ok(gpu) => {
+                    let mut samples = Samples::default();
+                    let mut gpu_film = None;
+                    for _ in 0..3 {
+                        let (t, r) = time(|| {
+                            rt_gpu::render_schlieren(
+                                &gpu,
+                                &setup,
+                                &medium,
+                                7,
+                                &mut |_, _| {},
+                                &|| false,
+                            )
+                        });
+                        gpu_film = Some(r.map_err(|e| e.to_string())?);
+                        samples.0.push(t);
+                    }
+                    let gpu_film = gpu_film.ok_or("no run")?;
+                    let soft = if gpu.is_software() { ", a software driver" } else { "" };
+                    out.push(DenseRow {
+                        interp: "gpu-trilinear",
+                        on: format!("{}{soft}", gpu.name()),
+                        photons: gpu_film.emitted,
+                        seconds: samples.best(),
+                        spread: samples.spread(),
+                        rmse: rmse(&gpu_film, &reference),
+                        steps_per_photon: f64::NAN,
+                        evals_per_photon: f64::NAN,
+                    });
+                }
+                Err(e) => eprintln!("rt-report: no GPU row: {e}"),
+            }
+        }
         out.push(DenseRow {
             interp: name,
+            on: "one CPU thread".into(),
             photons: film.emitted,
             seconds: samples.best(),
             spread: samples.spread(),
@@ -130,27 +173,33 @@ pub(crate) fn table(rows: &[DenseRow], size: u32, photons: u32) -> (String, Vec<
     let mut md = format!(
         "\n**Dense field** ({DENSE_GRID}³ [`dense_flow`]: disturbed everywhere), as `rt schlieren` \
          renders it ({size} px, {photons} photons per pixel, the set-up's defaults), one thread; \
-         rmse against RK4 at h/4 with the same photons:\n\n\
-         | interpolant | photons | seconds (best of 3) | spread | photons per CPU-second | steps per photon | evaluations per photon | rmse |\n\
-         |---|---|---|---|---|---|---|---|\n"
+         rmse against RK4 at h/4 with the same photons. The GPU row (where there is an adapter: \
+         `rt schlieren --device gpu`, rt-gpu) runs the same set-up with its photons traced on the \
+         device in f32, no octree; on a software driver (Mesa's lavapipe, on these same cores) \
+         its rate is only a check that it runs:\n\n\
+         | tracer | on | photons | seconds (best of 3) | spread | photons per second | steps per photon | evaluations per photon | rmse |\n\
+         |---|---|---|---|---|---|---|---|---|\n"
     );
+    let count = |x: f64| if x.is_nan() { "–".to_string() } else { format!("{x:.1}") };
     for r in rows {
         writeln!(
             md,
-            "| {} | {} | {:.3} | +{:.0}% | {:.0} | {:.1} | {:.1} | {:.2e} |",
+            "| {} | {} | {} | {:.3} | +{:.0}% | {:.0} | {} | {} | {:.2e} |",
             r.interp,
+            r.on,
             r.photons,
             r.seconds,
             r.spread,
             r.photons as f64 / r.seconds,
-            r.steps_per_photon,
-            r.evals_per_photon,
+            count(r.steps_per_photon),
+            count(r.evals_per_photon),
             r.rmse
         )
         .unwrap();
     }
     let mut verdicts = Vec::new();
-    if let [lin, cubic] = rows {
+    let rt = |name: &str| rows.iter().find(|r| r.interp == name);
+    if let (Some(lin), Some(cubic)) = (rt("rt-trilinear"), rt("rt-catmull-rom")) {
         let ratio = cubic.seconds / lin.seconds;
         verdicts.push(format!(
             "dense {DENSE_GRID}³: Catmull–Rom costs {ratio:.2}× trilinear (target ≤ 1.3×: {})",
