@@ -32,6 +32,15 @@ impl FilterImage {
         Self { size, rgb: alloc::vec![[0.0; 3]; size * size], half_range, round: false }
     }
 
+    /// A clear filter (every photon passes inside `±half_range`): the
+    /// picking pass of a filter to be painted, whose film records the
+    /// deflections at this filter's resolution ([`Cutoff::range`]: the
+    /// octree skips only what a pixel of it would not show).
+    #[must_use]
+    pub fn clear(size: usize, half_range: f64) -> Self {
+        Self { rgb: alloc::vec![[1.0; 3]; size * size], ..Self::opaque(size, half_range) }
+    }
+
     /// A hue wheel: colour by direction of `ε`, brightness by magnitude
     /// (rainbow schlieren). `half_range` sets full saturation, at the
     /// rim of the disc that transmits ([`FilterImage::round`]).
@@ -50,6 +59,23 @@ impl FilterImage {
             }
         }
         f.round = true;
+        f
+    }
+
+    /// `cutoff` sampled at the pixel centres of a `size × size` filter over
+    /// `±half_range` radians: a knife edge, graded filter or stop as a
+    /// filter to paint on (a painted filter's presets), the same light
+    /// transmitted to within a pixel of deflection.
+    #[must_use]
+    pub fn of_cutoff(cutoff: &Cutoff, size: usize, half_range: f64) -> Self {
+        let mut f = Self::opaque(size, half_range);
+        let prepared = cutoff.prepare();
+        for j in 0..size {
+            for i in 0..size {
+                f.rgb[i + size * j] = prepared.transmit(f.coord(i), f.coord(j));
+            }
+        }
+        f.round = matches!(cutoff, Cutoff::Color(c) if c.round);
         f
     }
 

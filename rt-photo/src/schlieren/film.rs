@@ -3,7 +3,7 @@
 use alloc::vec::Vec;
 use core::fmt;
 
-use super::sheet;
+use super::{cutoff::FilterImage, sheet};
 use crate::math;
 
 /// The reconstruction filter.
@@ -409,6 +409,25 @@ impl Film {
     /// [`Film::mean_deflection`] pixel by pixel.
     pub fn deflection_iter(&self) -> impl Iterator<Item = Option<(f64, f64)>> + '_ {
         self.eps.iter().map(|e| (e[2] > 0.0).then(|| (e[0] / e[2], e[1] / e[2])))
+    }
+
+    /// The image `filter` gives from the deflections this film recorded
+    /// (the picking pass: a render through [`FilterImage::clear`]), without
+    /// tracing again:
+    /// each pixel's light ([`Film::normalized_iter`]'s first channel) times
+    /// what `filter` transmits at its photons' mean deflection; empty
+    /// pixels dark. Exact where a pixel's photons share one deflection;
+    /// where they spread (a shock inside the pixel) it is the filter at
+    /// their mean, not the mean of the filter.
+    #[must_use]
+    pub fn through_filter(&self, filter: &FilterImage) -> Vec<[f32; 3]> {
+        self.normalized_iter()
+            .zip(self.deflection_iter())
+            .map(|(light, eps)| match eps {
+                Some((eu, ev)) => filter.at(eu, ev).map(|t| t * light[0] as f32),
+                None => [0.0; 3],
+            })
+            .collect()
     }
 
     /// Mean interferometric phase (radians, unwrapped: see

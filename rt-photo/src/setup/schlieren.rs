@@ -8,8 +8,8 @@ use rt_volume::Medium;
 
 use super::error::{finite, positive, within};
 use crate::{
-    Axis, Cutoff, Film, Filter, FilterImage, Mode, Reconstruction, SchlierenBench, SetupError,
-    Survey,
+    Axis, BenchError, Cutoff, Film, Filter, FilterImage, Mode, Reconstruction, SchlierenBench,
+    SetupError, Survey,
     units::{index, si, sig3},
 };
 
@@ -183,6 +183,34 @@ impl SchlierenSetup {
             ..SchlierenBench::through(medium.bounds(), o.axis, mode, film_distance, params)
         };
         Ok(Self { bench, size: (w, h), options: o.clone(), warning })
+    }
+
+    /// The set-up with `filter` in its focal plane instead of its cutoff
+    /// (a filter the user painted: [`FilterImage::read_png`]); the title
+    /// and line say "colour filter".
+    ///
+    /// # Errors
+    /// [`BenchError::Cutoff`] for a filter that is empty, of the wrong
+    /// size or not finite.
+    pub fn with_filter(mut self, filter: FilterImage) -> Result<Self, SetupError> {
+        let cutoff = Cutoff::Color(filter);
+        cutoff.validate().map_err(BenchError::Cutoff)?;
+        self.bench.mode = Mode::Schlieren(cutoff);
+        self.options.cutoff = CutoffKind::Color;
+        Ok(self)
+    }
+
+    /// The colour filter's rim this set-up chose or was given (radians), or
+    /// the deflection range its cutoff spans (`None`: no cutoff,
+    /// interferometry): the scale of the focal plane a painted filter
+    /// covers.
+    #[must_use]
+    pub fn focal_range(&self) -> Option<f64> {
+        match &self.bench.mode {
+            Mode::Schlieren(Cutoff::Color(f)) => Some(f.half_range),
+            Mode::Schlieren(c) => c.range(),
+            Mode::Interferometry { .. } => None,
+        }
     }
 
     /// Renders the image through `medium` (whole passes of a lattice of
