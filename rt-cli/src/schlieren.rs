@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::ValueEnum;
 use rt_core::Frame;
 use rt_photo::{
-    Cutoff, CutoffKind as Kind, Film, Medium, Mode, Reconstruction, SchlierenOptions,
+    Cutoff, CutoffKind as Kind, Film, FilterImage, Medium, Mode, Reconstruction, SchlierenOptions,
     SchlierenSetup, traced_per_pixel, units::si,
 };
 use rt_volume::glam::DVec3;
@@ -82,6 +82,13 @@ pub struct Args {
     /// (surveyed at the image's resolution)].
     #[arg(long, value_parser = parse::positive, allow_hyphen_values = true)]
     pub half_range: Option<f64>,
+    /// A colour filter painted in a PNG, in place of the hue wheel (with
+    /// `--cutoff color`): square, its sRGB colours what it transmits,
+    /// spanning ±--half-range of deflection (automatic as for the wheel)
+    /// with εu rising left to right and εv bottom to top. `rt serve` saves
+    /// the filter painted on its page this way.
+    #[arg(long)]
+    pub filter: Option<PathBuf>,
     /// Interferometry wavelength in metres (CO₂ laser: 10.6e-6).
     #[arg(long, default_value = "10.6e-6", value_parser = parse::positive, allow_hyphen_values = true)]
     pub lambda: f64,
@@ -218,7 +225,14 @@ pub fn render(medium: &Medium, a: &Args) -> anyhow::Result<()> {
     }
     // Before any work: an impossible --out fails now, not after the render.
     let outs = Outputs::check(&targets)?;
-    let setup = SchlierenSetup::choose(medium, &a.options()).map_err(optics::hint)?;
+    if a.filter.is_some() && a.cutoff != CutoffKind::Color {
+        anyhow::bail!("--filter is a colour filter: add --cutoff color");
+    }
+    let mut setup = SchlierenSetup::choose(medium, &a.options()).map_err(optics::hint)?;
+    if let Some(path) = &a.filter {
+        let range = setup.focal_range().unwrap_or(1e-3);
+        setup = setup.with_filter(FilterImage::read_png(path, range)?).map_err(optics::hint)?;
+    }
     if let Some(w) = &setup.warning {
         eprintln!("rt: warning: {w}; raise --size or --lambda");
     }

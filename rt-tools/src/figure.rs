@@ -299,12 +299,22 @@ impl Figure {
                     let texts = WheelText {
                         title: "Deflection ε".into(),
                         marks: (format!("+{}", names.0), format!("+{}", names.1)),
-                        lines: vec![
-                            "hue: direction of ε".into(),
-                            "saturation: size |ε|".into(),
-                            format!("rim: |ε| = {}", si(filter.half_range, "rad")),
-                            "beyond the rim: black (cut)".into(),
-                        ],
+                        // A painted filter (square, not a wheel) says so.
+                        lines: if filter.round {
+                            vec![
+                                "hue: direction of ε".into(),
+                                "saturation: size |ε|".into(),
+                                format!("rim: |ε| = {}", si(filter.half_range, "rad")),
+                                "beyond the rim: black (cut)".into(),
+                            ]
+                        } else {
+                            vec![
+                                "a painted filter: what it".into(),
+                                "transmits at each ε".into(),
+                                format!("shown to |ε| = {}", si(filter.half_range, "rad")),
+                                "(its square reaches the corners)".into(),
+                            ]
+                        },
                     };
                     wheel(&side, filter, &texts, top, k)?;
                 }

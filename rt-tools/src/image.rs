@@ -81,16 +81,28 @@ fn create_parent(path: &Path) -> Result<(), WriteError> {
 /// linear (gAMA 1.0); `text` adds one `tEXt` comment. Creates the folder.
 fn encode(
     path: &Path,
-    (width, height): (u32, u32),
-    (color, depth): (png::ColorType, png::BitDepth),
+    size: (u32, u32),
+    format: (png::ColorType, png::BitDepth),
     srgb: bool,
     text: Option<&str>,
     data: &[u8],
 ) -> Result<(), WriteError> {
     create_parent(path)?;
-    let encode = |source| WriteError::Encode { path: path.to_path_buf(), source };
     let f = File::create(path).map_err(|source| WriteError::Io { path: path.into(), source })?;
-    let mut enc = png::Encoder::new(BufWriter::new(f), width, height);
+    encode_to(BufWriter::new(f), size, format, srgb, text, data)
+        .map_err(|source| WriteError::Encode { path: path.to_path_buf(), source })
+}
+
+/// [`encode`] into any writer.
+fn encode_to<W: std::io::Write>(
+    out: W,
+    (width, height): (u32, u32),
+    (color, depth): (png::ColorType, png::BitDepth),
+    srgb: bool,
+    text: Option<&str>,
+    data: &[u8],
+) -> Result<(), png::EncodingError> {
+    let mut enc = png::Encoder::new(out, width, height);
     enc.set_color(color);
     enc.set_depth(depth);
     if srgb {
@@ -99,11 +111,22 @@ fn encode(
         enc.set_source_gamma(png::ScaledFloat::new(1.0));
     }
     if let Some(text) = text {
-        enc.add_text_chunk("Comment".to_string(), text.to_string()).map_err(encode)?;
+        enc.add_text_chunk("Comment".to_string(), text.to_string())?;
     }
-    let mut w = enc.write_header().map_err(encode)?;
-    w.write_image_data(data).map_err(encode)?;
-    w.finish().map_err(encode)
+    let mut w = enc.write_header()?;
+    w.write_image_data(data)?;
+    w.finish()
+}
+
+/// A frame as the bytes of the PNG [`write_png`] writes (to serve it).
+///
+/// # Errors
+/// The encoder's error (none in practice for a frame's size).
+pub fn png_bytes(frame: &Frame) -> Result<Vec<u8>, png::EncodingError> {
+    let mut out = Vec::new();
+    let format = (png::ColorType::Rgba, png::BitDepth::Eight);
+    encode_to(&mut out, (frame.width(), frame.height()), format, true, None, &frame.to_srgba8())?;
+    Ok(out)
 }
 
 /// Writes a frame as an 8-bit sRGB RGBA PNG (straight alpha); creates
