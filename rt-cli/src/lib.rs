@@ -16,6 +16,8 @@
 //!   lens-and-grid system focused on a plane in the flow;
 //! - `rt view MESH`: a ray-traced picture of a mesh (OBJ, PLY, VTK)
 //!   coloured by one of its scalars;
+//! - `rt serve FILE`: the schlieren bench in the browser: move the knife,
+//!   paint a filter in the focal plane, watch the image refine;
 //! - `rt info FILE`: what a volume or mesh holds;
 //! - `rt distributed`: rendering across ranks (threads, or MPI processes
 //!   with feature `mpi`), checked bit for bit: a terrain with shadows and
@@ -41,6 +43,7 @@ pub mod optics;
 mod parse;
 mod progress;
 pub mod schlieren;
+pub mod serve;
 pub mod view;
 
 // What the commands write files with, shared with the report.
@@ -80,6 +83,10 @@ pub enum Command {
     /// for bit: a terrain (shadow and AO rays answered by every rank) or
     /// a volume (photons handed between bricks).
     Distributed(distributed::Args),
+    /// The schlieren bench in the browser: a local page where you move
+    /// the knife, paint a filter in the focal plane and watch the image
+    /// refine pass by pass.
+    Serve(serve::Args),
 }
 
 /// Runs one command.
@@ -95,6 +102,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::View(a) => view::run(&a),
         Command::Info(a) => info::run(&a),
         Command::Distributed(a) => distributed::run(&a),
+        Command::Serve(a) => serve::run(&a),
     }
 }
 
