@@ -12,13 +12,25 @@ use std::{
 };
 
 use rt_core::{Frame, Pixel};
-use rt_photo::{Cutoff, Film, FilterImage, Medium, Mode, SchlierenSetup, SetupError};
+use rt_photo::{
+    Cutoff, Film, FilterImage, Medium, Mode, SchlierenOptions, SchlierenSetup, SetupError,
+};
 
 use super::settings::{self, FileOptions, Settings};
 use crate::{image, optics};
 
 /// Pixels per side of the focal plane painted on (the page's canvas).
 pub(crate) const PAINT_SIZE: usize = 256;
+
+/// Photons in a first pass above which a preview is shown before it
+/// (about 30 ms on two cores).
+const PREVIEW_PHOTONS: u64 = 32_768;
+
+/// The photons one pass of `photons` per pixel traces per pixel.
+fn traced_per_pass(photons: u32) -> u64 {
+    let (k, _) = rt_photo::lattice(photons);
+    u64::from(k * k)
+}
 
 /// No frame asked for this long: the page is gone, the work stops.
 pub(crate) const IDLE: Duration = Duration::from_secs(3);
@@ -268,10 +280,14 @@ impl Engine {
         let chosen = rt_gpu::choose(self.device.into(), medium).map_err(|e| Some(e.to_string()))?;
         let device = chosen.describe();
         let stop = || self.generation() != generation || self.idle();
-        let command = match half_range {
+        let mut command = match half_range {
             Some(h) => settings.figure(&self.out.join("filter.png"), h),
             None => argv.clone(),
         };
+        // The same image from the command line needs the same device.
+        if matches!(chosen, rt_gpu::Chosen::Gpu(_)) {
+            command.extend(["--device".into(), "gpu".into()]);
+        }
         let base = Shown {
             generation,
             optics: setup.to_string(),
@@ -315,21 +331,38 @@ impl Engine {
             Ok(())
         };
         let (_, passes) = rt_photo::lattice(options.photons);
-        let result = setup.render_passes(&mut |_, _| {}, &mut |bench, film, p| {
+        let trace = |bench: &rt_photo::SchlierenBench, film: &mut Film, p: u64| {
             if stop() {
                 return Err(SetupError::Stopped);
             }
             match &tracer {
-                Some(tracer) => {
-                    tracer.schlieren_pass(bench, film, p, seed).map_err(|e| match e {
-                        rt_gpu::GpuError::Bench(b) => SetupError::SchlierenBench(b),
-                        _ => SetupError::Stopped,
-                    })?
-                }
+                Some(tracer) => tracer.schlieren_pass(bench, film, p, seed).map_err(|e| match e {
+                    rt_gpu::GpuError::Bench(b) => SetupError::SchlierenBench(b),
+                    _ => SetupError::Stopped,
+                }),
                 None => bench
                     .render_medium_until(medium, film, p, seed, &stop)
-                    .map_err(|e| if stop() { SetupError::Stopped } else { e.into() })?,
+                    .map_err(|e| if stop() { SetupError::Stopped } else { e.into() }),
             }
+        };
+        // A first pass of a large image takes long: show a preview (a
+        // quarter of the size, one 2 × 2 lattice, the same optics) first,
+        // so a change is seen within a frame or two.
+        let (w, h) = setup.size;
+        let per_pass = (w * h) as u64 * traced_per_pass(options.photons);
+        if per_pass > PREVIEW_PHOTONS {
+            let size = ((w / 4).max(16), (h / 4).max(16));
+            let o = SchlierenOptions { size: size.0 as u32, photons: 4, ..options.clone() };
+            let preview = SchlierenSetup { size, options: o, ..setup.clone() };
+            let film = preview.render_passes(&mut |_, _| {}, &mut |b, f, p| trace(b, f, p));
+            match film {
+                Ok(film) => publish(&film, 0, passes).map_err(|_| None)?,
+                Err(SetupError::Stopped) if stop() => return Err(None),
+                Err(e) => return Err(Some(e.to_string())),
+            }
+        }
+        let result = setup.render_passes(&mut |_, _| {}, &mut |bench, film, p| {
+            trace(bench, film, p)?;
             publish(film, p + 1, passes)
         });
         match result {
