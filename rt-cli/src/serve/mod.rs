@@ -1,7 +1,7 @@
 //! `rt serve FILE`: the schlieren bench in the browser. A local HTTP
 //! server (bound to 127.0.0.1 on a free port by default) serves one page
 //! and a small API; the page posts its settings, and polls for the
-//! newest image while the worker ([`engine`]) refines it pass by pass.
+//! newest image while the worker (`engine.rs`) refines it pass by pass.
 //!
 //! The API, all on the page's own origin (any request whose `Host` is not
 //! the server's, or whose `Origin` is another site's, is refused with 403;

@@ -186,8 +186,8 @@ impl SchlierenSetup {
     }
 
     /// The set-up with `filter` in its focal plane instead of its cutoff
-    /// (a filter the user painted: [`FilterImage::read_png`]); the title
-    /// and line say "colour filter".
+    /// (a filter the user painted: `FilterImage::read_png`, feature
+    /// `png`); the title and line say "colour filter".
     ///
     /// # Errors
     /// [`BenchError::Cutoff`] for a filter that is empty, of the wrong
