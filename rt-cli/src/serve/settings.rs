@@ -99,17 +99,11 @@ impl Settings {
     /// the colour filter's set-up (the picking pass replaces its wheel by
     /// a clear filter; the other cutoffs' options left out).
     pub(crate) fn traced(&self) -> Vec<String> {
-        let skip: &[&str] =
-            if self.paint { &["cutoff", "angle", "h", "radius", "lambda", "fringes"] } else { &[] };
-        let mut argv: Vec<String> = self
-            .args
-            .iter()
-            .filter(|(n, _)| !skip.contains(&n.as_str()))
-            .flat_map(|(n, v)| [format!("--{n}"), v.clone()])
-            .collect();
-        if self.paint {
-            argv.extend(["--cutoff", "color"].map(String::from));
+        if !self.paint {
+            return self.argv_without(&[]);
         }
+        let mut argv = self.argv_without(&PAINTED);
+        argv.extend(["--cutoff", "color"].map(String::from));
         argv
     }
 
@@ -119,13 +113,7 @@ impl Settings {
         if !self.paint {
             return self.traced();
         }
-        let skip = ["cutoff", "angle", "h", "radius", "half-range", "lambda", "fringes"];
-        let mut argv: Vec<String> = self
-            .args
-            .iter()
-            .filter(|(n, _)| !skip.contains(&n.as_str()))
-            .flat_map(|(n, v)| [format!("--{n}"), v.clone()])
-            .collect();
+        let mut argv = self.argv_without(&[&PAINTED[..], &["half-range"]].concat());
         argv.extend([
             "--cutoff".into(),
             "color".into(),
@@ -136,7 +124,19 @@ impl Settings {
         ]);
         argv
     }
+
+    /// `--name value` for each setting not in `skip`.
+    fn argv_without(&self, skip: &[&str]) -> Vec<String> {
+        self.args
+            .iter()
+            .filter(|(n, _)| !skip.contains(&n.as_str()))
+            .flat_map(|(n, v)| [format!("--{n}"), v.clone()])
+            .collect()
+    }
 }
+
+/// The options a painted filter replaces (the other cutoffs').
+const PAINTED: [&str; 6] = ["cutoff", "angle", "h", "radius", "lambda", "fringes"];
 
 /// How the served file is read, as `rt schlieren` options to repeat on
 /// its command line (only those that differ from the defaults).
