@@ -225,7 +225,13 @@ pub fn settle_triangle_t(
         return Some(t);
     }
     let (near, _) = bx.intersect_ray(&Ray { t_max: widen_far(t + slack()), ..*ray })?;
-    if near <= widen_far(t) { Some(t) } else { (near <= ray.t_max).then_some(near) }
+    // An unbounded slack (a determinant near zero) may reach a box whose
+    // near side is at infinity: that is no hit.
+    if near <= widen_far(t) {
+        Some(t)
+    } else {
+        (near <= ray.t_max && near < f32::INFINITY).then_some(near)
+    }
 }
 
 /// Whether a triangle hit at `t` lies inside the triangle's box as the
@@ -356,6 +362,20 @@ mod tests {
                 }
             }
             assert_eq!(missed, 0, "{s}");
+        }
+    }
+
+    /// Found by the `intersect` fuzz target: a ray grazing a triangle in
+    /// its plane, one vertex at `f32::MAX`, with `t_max = ∞`: the settling
+    /// slack was unbounded and the box's near side at infinity, so the hit
+    /// came back at `t = ∞`.
+    #[test]
+    fn fuzz_regression_no_hit_at_infinity() {
+        let ray = Ray::new(Vec3::new(-1e-45, 0.0, 0.0), Vec3::new(0.0, 1.0, -1e-45));
+        let (a, b, c) =
+            (Vec3::new(1.0, 1.192_092_9e-7, 0.0), Vec3::ZERO, Vec3::new(0.0, f32::MAX, 0.0));
+        if let Some(h) = intersect_triangle(&ray, a, b, c) {
+            assert!(h.t.is_finite(), "hit at t = {}", h.t);
         }
     }
 
